@@ -1,0 +1,321 @@
+//! Reading the tool's inputs: profile and waypoint CSVs, the vehicle TOML.
+
+use std::path::Path;
+
+use auvnav::{AutopilotConfig, Mission, PidGains, TfKind, TransferFunction, VehicleConfig};
+use serde::Deserialize;
+
+use crate::fail::Fail;
+
+/// Plant order capacity of the host tool.
+pub const ORDER: usize = 8;
+
+/// The bundled default line (spec/cli.md): Monterey Canyon 1.
+pub const BUNDLED_PROFILE: &str = include_str!("../../data/bathymetry/us_monterey_canyon_1.csv");
+pub const BUNDLED_WAYPOINTS: &str =
+    include_str!("../../data/bathymetry/us_monterey_canyon_1.waypoints.csv");
+
+/// Reads a whole text file, or fails with its name.
+pub fn read(path: &Path) -> Result<String, Fail> {
+    std::fs::read_to_string(path)
+        .map_err(|e| Fail::input(format!("{}: cannot read: {e}", path.display())))
+}
+
+/// Parses a CSV whose header names at least `columns` (in any order, more
+/// allowed); returns those columns, row by row.
+fn csv(text: &str, name: &str, columns: &[&str]) -> Result<Vec<Vec<f32>>, Fail> {
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let (_, header) = lines
+        .next()
+        .ok_or_else(|| Fail::input(format!("{name}: empty file")))?;
+    let header: Vec<&str> = header
+        .trim_start_matches('\u{feff}')
+        .split(',')
+        .map(str::trim)
+        .collect();
+    let index: Vec<usize> = columns
+        .iter()
+        .map(|c| {
+            header.iter().position(|h| h == c).ok_or_else(|| {
+                Fail::input(format!(
+                    "{name}:1: header must name column '{c}' (expected {})",
+                    columns.join(",")
+                ))
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let mut rows = Vec::new();
+    for (n, line) in lines {
+        let lineno = n + 1;
+        let fields: Vec<&str> = line.split(',').map(str::trim).collect();
+        if fields.len() != header.len() {
+            return Err(Fail::input(format!(
+                "{name}:{lineno}: expected {} fields, found {}",
+                header.len(),
+                fields.len()
+            )));
+        }
+        let mut row = Vec::with_capacity(index.len());
+        for (&i, col) in index.iter().zip(columns) {
+            let f = fields[i];
+            let v: f32 = f.parse().map_err(|_| {
+                Fail::input(format!("{name}:{lineno}: {col} '{f}' is not a number"))
+            })?;
+            if !v.is_finite() {
+                return Err(Fail::input(format!(
+                    "{name}:{lineno}: {col} '{f}' is not finite"
+                )));
+            }
+            row.push(v);
+        }
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// Profile CSV (`x_m,bottom_depth_m`): positions and depths, with `x`
+/// strictly increasing (checked here to name the line).
+pub fn profile(text: &str, name: &str) -> Result<(Vec<f32>, Vec<f32>), Fail> {
+    let rows = csv(text, name, &["x_m", "bottom_depth_m"])?;
+    if rows.len() < 2 {
+        return Err(Fail::input(format!(
+            "{name}: a profile needs at least 2 samples, found {}",
+            rows.len()
+        )));
+    }
+    let x: Vec<f32> = rows.iter().map(|r| r[0]).collect();
+    let b: Vec<f32> = rows.iter().map(|r| r[1]).collect();
+    increasing(&x, name, "x_m")?;
+    Ok((x, b))
+}
+
+/// Waypoints CSV (`wp,x_m`, more columns ignored): positions.
+pub fn waypoints(text: &str, name: &str) -> Result<Vec<f32>, Fail> {
+    let rows = csv(text, name, &["x_m"])?;
+    if rows.len() < 2 {
+        return Err(Fail::input(format!(
+            "{name}: need at least 2 waypoints (one track), found {}",
+            rows.len()
+        )));
+    }
+    let x: Vec<f32> = rows.iter().map(|r| r[0]).collect();
+    increasing(&x, name, "x_m")?;
+    Ok(x)
+}
+
+fn increasing(x: &[f32], name: &str, col: &str) -> Result<(), Fail> {
+    for (i, w) in x.windows(2).enumerate() {
+        if w[1] <= w[0] {
+            // Data row i + 1 is on line i + 3 (header on line 1), when the
+            // file has no blank lines.
+            return Err(Fail::input(format!(
+                "{name}:{}: {col} {} does not increase after {}",
+                i + 3,
+                w[1],
+                w[0]
+            )));
+        }
+    }
+    Ok(())
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FileConfig {
+    speed: Option<f64>,
+    sample_time: Option<f64>,
+    pitch_limit: Option<f64>,
+    elevator_limit: Option<f64>,
+    reference_altitude: Option<f64>,
+    min_altitude: Option<f64>,
+    initial_depth: Option<f64>,
+    depth_limits: Option<[f64; 2]>,
+    depth_pid: Option<FilePid>,
+    pitch_pid: Option<FilePid>,
+    plant: Option<FilePlant>,
+    optimizer: Option<FileOptimizer>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FilePid {
+    kp: Option<f64>,
+    ki: Option<f64>,
+    kd: Option<f64>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FilePlant {
+    kind: Option<String>,
+    num: Option<Vec<f64>>,
+    den: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FileOptimizer {
+    max_iterations: Option<u32>,
+}
+
+/// Optimizer settings from `[optimizer]`.
+#[derive(Clone, Copy, Debug)]
+pub struct OptimizerSettings {
+    pub max_iterations: u32,
+}
+
+/// Everything the config file sets, resolved against the defaults.
+pub struct Config {
+    pub vehicle: VehicleConfig,
+    pub plant: TransferFunction<ORDER>,
+    pub mission: Mission,
+    /// `None`: the default `b(X_0) - h_r`.
+    pub initial_depth: Option<f32>,
+    pub optimizer: OptimizerSettings,
+}
+
+/// A finite f32 from an optional f64 key, or the default.
+fn num(v: Option<f64>, default: f32, key: &str, name: &str) -> Result<f32, Fail> {
+    match v {
+        None => Ok(default),
+        Some(v) => {
+            let f = v as f32;
+            if f.is_finite() {
+                Ok(f)
+            } else {
+                Err(Fail::input(format!("{name}: {key} = {v} is not finite")))
+            }
+        }
+    }
+}
+
+fn nums(v: &[f64], key: &str, name: &str) -> Result<Vec<f32>, Fail> {
+    v.iter().map(|&x| num(Some(x), 0.0, key, name)).collect()
+}
+
+/// Parses and validates the vehicle TOML (`None`: all defaults).
+pub fn config(text: Option<(&str, &str)>) -> Result<Config, Fail> {
+    let (file, name) = match text {
+        None => (FileConfig::default(), ""),
+        Some((text, name)) => {
+            let parsed: FileConfig = toml::from_str(text).map_err(|e| {
+                let line = e
+                    .span()
+                    .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+                match line {
+                    Some(l) => Fail::input(format!("{name}:{l}: {}", e.message().trim())),
+                    None => Fail::input(format!("{name}: {}", e.message().trim())),
+                }
+            })?;
+            (parsed, name)
+        }
+    };
+    let d = VehicleConfig::default();
+    let dp = d.autopilot.depth_pid;
+    let pp = d.autopilot.pitch_pid;
+    let fd = file.depth_pid.unwrap_or_default();
+    let fp = file.pitch_pid.unwrap_or_default();
+    let vehicle = VehicleConfig {
+        speed: num(file.speed, d.speed, "speed", name)?,
+        sample_time: num(file.sample_time, d.sample_time, "sample_time", name)?,
+        autopilot: AutopilotConfig {
+            depth_pid: PidGains {
+                kp: num(fd.kp, dp.kp, "depth_pid.kp", name)?,
+                ki: num(fd.ki, dp.ki, "depth_pid.ki", name)?,
+                kd: num(fd.kd, dp.kd, "depth_pid.kd", name)?,
+            },
+            pitch_pid: PidGains {
+                kp: num(fp.kp, pp.kp, "pitch_pid.kp", name)?,
+                ki: num(fp.ki, pp.ki, "pitch_pid.ki", name)?,
+                kd: num(fp.kd, pp.kd, "pitch_pid.kd", name)?,
+            },
+            pitch_limit: num(
+                file.pitch_limit,
+                d.autopilot.pitch_limit,
+                "pitch_limit",
+                name,
+            )?,
+            elevator_limit: num(
+                file.elevator_limit,
+                d.autopilot.elevator_limit,
+                "elevator_limit",
+                name,
+            )?,
+        },
+    };
+    let plant = plant(file.plant.unwrap_or_default(), name)?;
+    let m = Mission::default();
+    let limits = match file.depth_limits {
+        None => m.depth_limits(),
+        Some([lo, hi]) => [
+            num(Some(lo), 0.0, "depth_limits", name)?,
+            num(Some(hi), 0.0, "depth_limits", name)?,
+        ],
+    };
+    let mission = Mission::new(
+        num(
+            file.reference_altitude,
+            m.reference_altitude(),
+            "reference_altitude",
+            name,
+        )?,
+        num(file.min_altitude, m.min_altitude(), "min_altitude", name)?,
+        limits,
+    )
+    .map_err(|e| Fail::input(format!("{}{e}", prefix(name))))?;
+    let initial_depth = match file.initial_depth {
+        None => None,
+        Some(v) => Some(num(Some(v), 0.0, "initial_depth", name)?),
+    };
+    let opt = file.optimizer.unwrap_or_default();
+    let max_iterations = opt.max_iterations.unwrap_or(200);
+    if max_iterations == 0 {
+        return Err(Fail::input(format!(
+            "{}optimizer.max_iterations must be at least 1",
+            prefix(name)
+        )));
+    }
+    Ok(Config {
+        vehicle,
+        plant,
+        mission,
+        initial_depth,
+        optimizer: OptimizerSettings { max_iterations },
+    })
+}
+
+/// `"NAME: "` or nothing for the built-in defaults.
+pub fn prefix(name: &str) -> String {
+    if name.is_empty() {
+        String::new()
+    } else {
+        format!("{name}: ")
+    }
+}
+
+fn plant(p: FilePlant, name: &str) -> Result<TransferFunction<ORDER>, Fail> {
+    let kind = match p.kind.as_deref() {
+        None | Some("pitch") => TfKind::Pitch,
+        Some("rate") => TfKind::Rate,
+        Some(other) => {
+            return Err(Fail::input(format!(
+                "{}plant.kind must be \"pitch\" or \"rate\", got \"{other}\"",
+                prefix(name)
+            )));
+        }
+    };
+    let den = match &p.den {
+        Some(v) => nums(v, "plant.den", name)?,
+        None => vec![1.0, 2.681, 0.546, 0.048],
+    };
+    let num_ = match (&p.num, kind) {
+        (Some(v), _) => nums(v, "plant.num", name)?,
+        (None, TfKind::Pitch) => vec![-0.173],
+        (None, TfKind::Rate) => vec![-0.173, 0.0],
+    };
+    TransferFunction::new(kind, &num_, &den)
+        .map_err(|e| Fail::input(format!("{}plant: {e}", prefix(name))))
+}

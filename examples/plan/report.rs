@@ -1,0 +1,176 @@
+//! What the tool prints: the JSON object of spec/cli.md, a table, and the
+//! trajectory CSV.
+
+use std::io::Write;
+use std::path::Path;
+
+use serde_json::{Value, json};
+
+use crate::fail::Fail;
+
+/// One track's line of the report.
+#[derive(Clone, Debug)]
+pub struct TrackReport {
+    pub x_start: f32,
+    pub x_end: f32,
+    pub depth: f32,
+    pub j: f32,
+    pub rms: f32,
+    pub min_altitude: f32,
+    pub safe: bool,
+    pub iterations: u32,
+    pub evaluations: u32,
+    pub status: &'static str,
+    pub j_history: Vec<f32>,
+}
+
+/// The whole report.
+pub struct Report {
+    pub method: &'static str,
+    pub mode: &'static str,
+    pub tracks: Vec<TrackReport>,
+}
+
+impl Report {
+    pub fn total_j(&self) -> f32 {
+        self.tracks.iter().map(|t| t.j).sum()
+    }
+    pub fn min_altitude(&self) -> f32 {
+        self.tracks
+            .iter()
+            .map(|t| t.min_altitude)
+            .fold(f32::INFINITY, f32::min)
+    }
+    pub fn safe(&self) -> bool {
+        self.tracks.iter().all(|t| t.safe)
+    }
+
+    /// The JSON object, field for field as spec/cli.md.
+    pub fn json(&self) -> Value {
+        let tracks: Vec<Value> = self
+            .tracks
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                json!({
+                    "track": i + 1,
+                    "x_start": num(t.x_start),
+                    "x_end": num(t.x_end),
+                    "depth": num(t.depth),
+                    "J": num(t.j),
+                    "rms": num(t.rms),
+                    "min_altitude": num(t.min_altitude),
+                    "safe": t.safe,
+                    "iterations": t.iterations,
+                    "evaluations": t.evaluations,
+                    "status": t.status,
+                    "J_history": t.j_history.iter().map(|&v| num(v)).collect::<Vec<_>>(),
+                })
+            })
+            .collect();
+        json!({
+            "method": self.method,
+            "mode": self.mode,
+            "tracks": tracks,
+            "total_J": num(self.total_j()),
+            "min_altitude": num(self.min_altitude()),
+            "safe": self.safe(),
+        })
+    }
+
+    /// The human-readable table.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "method {}, mode {}\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>5} {:>5} {:>5}  {}\n",
+            self.method,
+            self.mode,
+            "track",
+            "x_start",
+            "x_end",
+            "depth m",
+            "J m^3",
+            "rms m",
+            "min alt",
+            "safe",
+            "iter",
+            "eval",
+            "status"
+        );
+        for (i, t) in self.tracks.iter().enumerate() {
+            s += &format!(
+                "{:>5} {:>9.1} {:>9.1} {:>10.2} {:>14.1} {:>8.2} {:>9.2} {:>5} {:>5} {:>5}  {}\n",
+                i + 1,
+                t.x_start,
+                t.x_end,
+                t.depth,
+                t.j,
+                t.rms,
+                t.min_altitude,
+                if t.safe { "yes" } else { "NO" },
+                t.iterations,
+                t.evaluations,
+                t.status
+            );
+        }
+        s += &format!(
+            "total J {:.1} m^3, min altitude {:.2} m, {}\n",
+            self.total_j(),
+            self.min_altitude(),
+            if self.safe() {
+                "safe"
+            } else {
+                "NOT SAFE: the flight goes below the minimum altitude"
+            }
+        );
+        s
+    }
+}
+
+/// An f32 as the shortest decimal that reads back as the same f32.
+pub fn num(v: f32) -> Value {
+    v.to_string()
+        .parse::<f64>()
+        .ok()
+        .and_then(serde_json::Number::from_f64)
+        .map_or(Value::Null, Value::Number)
+}
+
+/// One trajectory row; `None` prints an empty field (no bottom past the
+/// profile, no command at the final sample).
+pub struct TrajRow {
+    pub x: f32,
+    pub depth: f32,
+    pub bottom: Option<f32>,
+    pub target: Option<f32>,
+    pub pitch: f32,
+    pub elevator: Option<f32>,
+    pub reference: Option<f32>,
+}
+
+/// Writes the trajectory CSV.
+pub fn write_trajectory(path: &Path, rows: &[TrajRow]) -> Result<(), Fail> {
+    let fail = |e: std::io::Error| Fail::input(format!("{}: cannot write: {e}", path.display()));
+    let f = std::fs::File::create(path).map_err(fail)?;
+    let mut w = std::io::BufWriter::new(f);
+    let opt = |v: Option<f32>| v.map(|v| v.to_string()).unwrap_or_default();
+    writeln!(
+        w,
+        "x_m,depth_m,bottom_m,target_m,pitch_deg,elevator_deg,reference_m"
+    )
+    .map_err(fail)?;
+    for r in rows {
+        writeln!(
+            w,
+            "{},{},{},{},{},{},{}",
+            r.x,
+            r.depth,
+            opt(r.bottom),
+            opt(r.target),
+            r.pitch,
+            opt(r.elevator),
+            opt(r.reference)
+        )
+        .map_err(fail)?;
+    }
+    w.flush().map_err(fail)
+}
