@@ -96,6 +96,11 @@ impl From<ConfigError> for Error {
         Self::Config(e)
     }
 }
+impl From<crate::sim::WaypointError> for Error {
+    fn from(e: crate::sim::WaypointError) -> Self {
+        Self::Sim(SimError::Waypoints(e))
+    }
+}
 impl From<SimError> for Error {
     fn from(e: SimError) -> Self {
         Self::Sim(e)

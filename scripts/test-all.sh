@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Runs every test of the project, host and target, doing its own set-up.
+# This is the README's test command; CI (.ci/run) calls it too.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+say() { printf '\n==> %s\n' "$*"; }
+
+say "set-up: Rust targets"
+for t in thumbv7em-none-eabihf thumbv7m-none-eabi; do
+  rustup target list --installed | grep -qx "$t" || rustup target add "$t"
+done
+
+say "host: cargo test (unit, golden fixtures, tool interface, doctests)"
+cargo test --all-targets
+cargo test --doc
+
+say "target: the library builds for Cortex-M4F (thumbv7em-none-eabihf), with and without defmt"
+cargo build --lib --release --target thumbv7em-none-eabihf
+cargo build --lib --release --target thumbv7em-none-eabihf --features defmt
+cargo build --lib --release --target thumbv7m-none-eabi
+
+say "all tests passed"

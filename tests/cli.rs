@@ -1,0 +1,338 @@
+//! The `plan` tool's interface (spec/cli.md): every bad input is one line
+//! on stderr and exit status 2, never a panic; good input gives the JSON
+//! object and trajectory CSV the spec fixes.
+//!
+//! `cargo test` builds the examples before it runs the tests, so the tool
+//! is found beside this test binary.
+
+// Test code: a failed unwrap or index is a failed test.
+#![allow(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+#![allow(clippy::arithmetic_side_effects, clippy::float_cmp)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tool() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    let dir = exe.parent().unwrap().parent().unwrap();
+    let p = dir
+        .join("examples")
+        .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
+    assert!(p.exists(), "{} not built (run via cargo test)", p.display());
+    p
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(tool()).args(args).output().unwrap()
+}
+
+fn tmp(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("auvnav-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const PROFILE: &str = "x_m,bottom_depth_m\n0,100\n100,110\n200,90\n300,100\n";
+const WAYPOINTS: &str = "wp,x_m\n0,0\n1,150\n2,300\n";
+
+/// Runs the tool and checks the one-line, exit-2 contract; returns stderr.
+fn bad(args: &[&str], must_mention: &str) -> String {
+    let out = run(args);
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "args {args:?}: stderr {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err:?}");
+    assert!(
+        err.to_lowercase().contains(&must_mention.to_lowercase()),
+        "{args:?}: {err:?} should mention {must_mention:?}"
+    );
+    assert!(out.stdout.is_empty());
+    err
+}
+
+fn with(profile: &str, waypoints: &str, extra: &[&str]) -> Vec<String> {
+    let p = tmp(&format!("p{}.csv", fxhash(profile)), profile);
+    let w = tmp(&format!("w{}.csv", fxhash(waypoints)), waypoints);
+    let mut v = vec![
+        "--profile".to_string(),
+        p.display().to_string(),
+        "--waypoints".into(),
+        w.display().to_string(),
+    ];
+    v.extend(extra.iter().map(|s| s.to_string()));
+    v
+}
+
+fn fxhash(s: &str) -> u64 {
+    s.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)
+    })
+}
+
+fn refs(v: &[String]) -> Vec<&str> {
+    v.iter().map(String::as_str).collect()
+}
+
+#[test]
+fn missing_and_unreadable_files() {
+    bad(
+        &[
+            "--profile",
+            "/nonexistent/p.csv",
+            "--waypoints",
+            "/nonexistent/w.csv",
+        ],
+        "/nonexistent/p.csv",
+    );
+    let dir = std::env::temp_dir();
+    let d = dir.display().to_string();
+    bad(&["--profile", &d, "--waypoints", &d], "cannot read");
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--config", "/nonexistent/v.toml", "--depths", "20,20"],
+    );
+    bad(&refs(&a), "v.toml");
+}
+
+#[test]
+fn malformed_csv() {
+    let a = with(
+        "x_m,bottom_depth_m\n0,100\n100\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), ":3: expected 2 fields");
+    let a = with(
+        "x,depth\n0,100\n100,100\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "x_m");
+    let a = with(
+        "x_m,bottom_depth_m\n0,100\n100,abc\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "not a number");
+    let a = with(PROFILE, "wp\n0\n1\n", &["--depths", "20,20"]);
+    bad(&refs(&a), "x_m");
+    let a = with("", WAYPOINTS, &["--depths", "20,20"]);
+    bad(&refs(&a), "empty");
+    let a = with(
+        "x_m,bottom_depth_m\n0,100\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "at least 2");
+}
+
+#[test]
+fn non_finite_numbers() {
+    for v in ["nan", "inf", "-inf", "NaN"] {
+        let p = format!("x_m,bottom_depth_m\n0,100\n100,{v}\n300,100\n");
+        let a = with(&p, WAYPOINTS, &["--depths", "20,20"]);
+        bad(&refs(&a), "not finite");
+    }
+    let a = with(PROFILE, "wp,x_m\n0,0\n1,nan\n", &["--depths", "20"]);
+    bad(&refs(&a), "not finite");
+    let a = with(PROFILE, WAYPOINTS, &["--depths", "20,inf"]);
+    bad(&refs(&a), "not finite");
+    let c = tmp("nan.toml", "speed = nan\n");
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--config", c.to_str().unwrap(), "--depths", "20,20"],
+    );
+    bad(&refs(&a), "speed");
+}
+
+#[test]
+fn non_increasing_x() {
+    let a = with(
+        "x_m,bottom_depth_m\n0,100\n100,100\n100,90\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "does not increase");
+    let a = with(
+        "x_m,bottom_depth_m\n0,100\n200,100\n100,90\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "does not increase");
+    let a = with(
+        PROFILE,
+        "wp,x_m\n0,0\n1,200\n2,150\n",
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "does not increase");
+}
+
+#[test]
+fn waypoint_outside_profile() {
+    let a = with(
+        PROFILE,
+        "wp,x_m\n0,0\n1,150\n2,301\n",
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "outside the bottom profile");
+    let a = with(PROFILE, "wp,x_m\n0,-5\n1,150\n", &["--depths", "20"]);
+    bad(&refs(&a), "waypoint 0");
+}
+
+#[test]
+fn wrong_number_of_depths() {
+    let a = with(PROFILE, WAYPOINTS, &["--depths", "20"]);
+    bad(&refs(&a), "1 depths for 2 tracks");
+    let a = with(PROFILE, WAYPOINTS, &["--depths", "20,20,20"]);
+    bad(&refs(&a), "3 depths for 2 tracks");
+    let a = with(PROFILE, WAYPOINTS, &["--depths", "20,x"]);
+    bad(&refs(&a), "not a number");
+}
+
+#[test]
+fn config_errors() {
+    let cases = [
+        ("sped = 1.5\n", "unknown field"),
+        ("[depth_pid]\nkpp = 1\n", "unknown field"),
+        ("[nonsense]\n", "unknown field"),
+        (
+            "min_altitude = 90.0\nreference_altitude = 80.0\n",
+            "min_altitude",
+        ),
+        ("speed = 0.0\n", "speed must be positive"),
+        ("speed = -1.5\n", "speed must be positive"),
+        ("sample_time = 0\n", "sample_time must be positive"),
+        ("pitch_limit = 95\n", "pitch_limit"),
+        ("min_altitude = -1\n", "min_altitude"),
+        ("depth_limits = [100.0, 0.0]\n", "depth_limits"),
+        ("[depth_pid]\nkp = -1\n", "depth_pid.kp"),
+        ("speed = \"fast\"\n", "invalid type"),
+        ("speed = 1.5\nspeed = 2\n", "duplicate"),
+        ("[plant]\nkind = \"gain\"\n", "plant.kind"),
+        ("[plant]\nnum = [1.0, 0.0, 0.1]\n", "relative degree"),
+        (
+            "[plant]\nkind = \"rate\"\nnum = [-0.173, 0.5]\n",
+            "zero constant term",
+        ),
+        (
+            "[plant]\nden = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0]\n",
+            "order",
+        ),
+        ("[optimizer]\nmax_iterations = 0\n", "max_iterations"),
+        ("speed = 1.5\n[[", "v.toml:2"),
+    ];
+    for (text, mention) in cases {
+        let c = tmp("v.toml", text);
+        let a = with(
+            PROFILE,
+            WAYPOINTS,
+            &["--config", c.to_str().unwrap(), "--depths", "20,20"],
+        );
+        bad(&refs(&a), mention);
+    }
+}
+
+#[test]
+fn bad_command_lines() {
+    bad(&["--method", "newton"], "--method");
+    bad(&["--mode", "sideways"], "--mode");
+    bad(&["--horizon", "0"], "--horizon");
+    bad(&["--frobnicate"], "unknown argument");
+    bad(&["--profile", "p.csv"], "--waypoints");
+    bad(&["--depths"], "needs a value");
+}
+
+fn json_of(args: &[&str]) -> serde_json::Value {
+    let out = run(args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn evaluate_json_has_every_field() {
+    let v = json_of(&["--depths", "990,900,700,400,250", "--json"]);
+    assert_eq!(v["method"], "fixed");
+    let tracks = v["tracks"].as_array().unwrap();
+    assert_eq!(tracks.len(), 5);
+    let keys = [
+        "track",
+        "x_start",
+        "x_end",
+        "depth",
+        "J",
+        "rms",
+        "min_altitude",
+        "safe",
+        "iterations",
+        "evaluations",
+        "status",
+        "J_history",
+    ];
+    for (i, t) in tracks.iter().enumerate() {
+        for k in keys {
+            assert!(t.get(k).is_some(), "track {i} lacks {k}");
+        }
+        assert_eq!(t["track"], i + 1);
+        assert_eq!(t["status"], "fixed");
+        assert_eq!(t["iterations"], 0);
+        assert_eq!(t["J_history"].as_array().unwrap().len(), 0);
+        let j = t["J"].as_f64().unwrap();
+        let rms = t["rms"].as_f64().unwrap();
+        let len = t["x_end"].as_f64().unwrap() - t["x_start"].as_f64().unwrap();
+        assert!((rms - (2.0 * j / len).sqrt()).abs() < 1e-3 * rms);
+    }
+    let total: f64 = tracks.iter().map(|t| t["J"].as_f64().unwrap()).sum();
+    assert!((v["total_J"].as_f64().unwrap() - total).abs() <= 1e-5 * total);
+    let min = tracks
+        .iter()
+        .map(|t| t["min_altitude"].as_f64().unwrap())
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(v["min_altitude"].as_f64().unwrap(), min);
+    assert_eq!(v["safe"], tracks.iter().all(|t| t["safe"] == true));
+}
+
+#[test]
+fn trajectory_csv_has_every_sample() {
+    let dir = std::env::temp_dir().join(format!("auvnav-traj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("t.csv");
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--depths", "20,15", "--trajectory", out.to_str().unwrap()],
+    );
+    let o = run(&refs(&a));
+    assert_eq!(o.status.code(), Some(0));
+    let text = std::fs::read_to_string(Path::new(&out)).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(
+        lines.next().unwrap(),
+        "x_m,depth_m,bottom_m,target_m,pitch_deg,elevator_deg,reference_m"
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    // 300 m at 0.15 m per step: about 2000 samples, the first at x = 0.
+    assert!(rows.len() > 1900 && rows.len() < 2100, "{}", rows.len());
+    assert_eq!(rows[0][0], "0");
+    assert_eq!(rows[0][6], "20");
+    let last = rows.last().unwrap();
+    assert!(last[0].parse::<f32>().unwrap() >= 300.0);
+    assert_eq!(last[5], "", "no command at the final sample");
+    // The reference switches at the first sample past the waypoint.
+    let switch = rows.iter().position(|r| r[6] == "15").unwrap();
+    assert!(rows[switch][0].parse::<f32>().unwrap() >= 150.0);
+    assert!(rows[switch - 1][0].parse::<f32>().unwrap() < 150.0);
+}
