@@ -15,7 +15,7 @@
 //! samples is scored into the tracks it overlaps as it is flown, so a run
 //! costs one pass and no trajectory storage.
 //!
-//! The loop is written once. A [`Sensitivity`] hook receives what each step
+//! The loop is written once. A `Sensitivity` hook receives what each step
 //! and each scored segment linearize to; the plain simulation passes a
 //! no-op that compiles away, the gradient ([`crate::gradient`]) propagates
 //! tangents in the same pass.
