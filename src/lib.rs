@@ -55,13 +55,14 @@
 //! # Ok::<(), auvnav::Error>(())
 //! ```
 #![no_std]
-#![cfg_attr(test, allow(clippy::float_cmp))]
+#![cfg_attr(test, allow(clippy::float_cmp, clippy::arithmetic_side_effects))]
 
 pub mod autopilot;
 pub mod error;
 pub mod expm;
 pub mod gradient;
 mod num;
+pub mod optim;
 pub mod plant;
 pub mod profile;
 pub mod sim;

@@ -1,0 +1,154 @@
+//! Gradient descent with a constant learning rate: `ζ <- P(ζ − κ G)`
+//! (paper eq. 3.6, projected on the box). The paper's baseline: its
+//! convergence depends entirely on `κ`, which is the point of comparing it
+//! with BFGS.
+
+use nalgebra::SVector;
+
+use super::{Bounds, HISTORY, Objective, OptimError, Outcome, Status, Tolerances, start};
+
+/// Gradient-descent settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct GdConfig {
+    /// Learning rate `κ`, m per m² of gradient (1/m), > 0.
+    pub rate: f32,
+    /// Iteration cap, ≥ 1. Default 200 (paper §5.3.1).
+    pub max_iterations: u32,
+    /// Stopping rules.
+    pub tol: Tolerances,
+}
+
+impl GdConfig {
+    /// `Ok` when every setting is in range, else its name.
+    pub fn validate(&self) -> Result<(), &'static str> {
+        if !(self.rate.is_finite() && self.rate > 0.0) {
+            return Err("gd_rate");
+        }
+        if self.max_iterations == 0 {
+            return Err("max_iterations");
+        }
+        if !self.tol.is_valid() {
+            return Err("tolerances");
+        }
+        Ok(())
+    }
+}
+
+/// Minimizes `obj` from `z0` within `bounds` by constant-rate gradient
+/// descent. An evaluation that fails or is not finite ends the run with
+/// [`Status::LineSearchFailed`] at the last good point.
+///
+/// # Errors
+/// [`OptimError`] for an invalid configuration or box, or a failed start.
+pub fn gradient_descent<const K: usize, O: Objective<K>>(
+    obj: &mut O,
+    z0: &SVector<f32, K>,
+    bounds: &Bounds<K>,
+    cfg: &GdConfig,
+) -> Result<Outcome<K>, OptimError<O::Error>> {
+    cfg.validate().map_err(OptimError::Config)?;
+    if !bounds.is_valid() {
+        return Err(OptimError::Config("bounds"));
+    }
+    let mut z = bounds.project(z0);
+    let (mut j, mut g) = start(obj, &z)?;
+    let mut evaluations = 1_u32;
+    let mut history = heapless::Vec::<f32, HISTORY>::new();
+    let _ = history.push(j);
+    let mut iterations = 0_u32;
+    let status = loop {
+        if bounds.free_gradient(&z, &g).norm() <= cfg.tol.grad {
+            break Status::Converged;
+        }
+        if iterations >= cfg.max_iterations {
+            break Status::MaxIterations;
+        }
+        let zt = bounds.project(&(z - g * cfg.rate));
+        if zt == z {
+            // Pinned against the box: no move left.
+            break Status::Converged;
+        }
+        evaluations = evaluations.saturating_add(1);
+        let (jt, gt) = match obj.eval(&zt) {
+            Ok((jt, gt)) if jt.is_finite() && gt.iter().all(|v| v.is_finite()) => (jt, gt),
+            _ => break Status::LineSearchFailed,
+        };
+        let dj = j - jt;
+        z = zt;
+        j = jt;
+        g = gt;
+        iterations = iterations.saturating_add(1);
+        let _ = history.push(j);
+        if libm::fabsf(dj) <= cfg.tol.j_threshold(j) {
+            break Status::Converged;
+        }
+    };
+    Ok(Outcome {
+        grad_norm: bounds.free_gradient(&z, &g).norm(),
+        z,
+        j,
+        gradient: g,
+        status,
+        iterations,
+        evaluations,
+        skipped_updates: 0,
+        history,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testfns::Quadratic;
+    use super::*;
+    use nalgebra::{Matrix2, Vector2};
+
+    #[test]
+    fn converges_linearly_on_a_quadratic() {
+        let mut q = Quadratic {
+            h: Matrix2::new(2.0, 0.0, 0.0, 0.5),
+            b: Vector2::zeros(),
+        };
+        let cfg = GdConfig {
+            rate: 0.4,
+            max_iterations: 500,
+            tol: Tolerances {
+                grad: 1e-5,
+                rel: 0.0,
+                floor: 1.0,
+            },
+        };
+        // Minimum value 0 at the origin, so f32 resolves J all the way.
+        let out = gradient_descent(
+            &mut q,
+            &Vector2::new(-1.0, -2.0),
+            &Bounds::uniform(-9.0, 9.0),
+            &cfg,
+        )
+        .unwrap();
+        assert_eq!(out.status, Status::Converged);
+        assert!(out.z.amax() < 1e-4, "{}", out.z);
+        // The slow mode contracts by 1 - 0.4 * 0.5 = 0.8 per iteration.
+        assert!(out.iterations > 40, "{}", out.iterations);
+        assert_eq!(out.evaluations, out.iterations + 1);
+        assert!(out.history.windows(2).all(|w| w[1] <= w[0]));
+    }
+
+    #[test]
+    fn rejects_a_bad_rate() {
+        let mut q = Quadratic {
+            h: Matrix2::identity(),
+            b: Vector2::zeros(),
+        };
+        let cfg = GdConfig {
+            rate: -1.0,
+            max_iterations: 5,
+            tol: Tolerances::default(),
+        };
+        assert_eq!(
+            gradient_descent(&mut q, &Vector2::zeros(), &Bounds::uniform(-1.0, 1.0), &cfg)
+                .unwrap_err(),
+            OptimError::Config("gd_rate")
+        );
+    }
+}

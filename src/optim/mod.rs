@@ -1,0 +1,271 @@
+//! Allocation-free optimizers for the reference depths: gradient descent
+//! (the paper's baseline, eq. 3.6) and dense BFGS with an Armijo
+//! backtracking line search (eqs. 3.7–3.13), both on a box.
+//!
+//! The dimension `K` is a const generic; a problem may use fewer variables
+//! by pinning the others (`lo == hi` in [`Bounds`]). Non-convergence is an
+//! [`Outcome`] with a [`Status`], never an error; only a failed evaluation
+//! at the starting point is an error.
+//!
+//! Every numerical safeguard is named and documented where it acts:
+//! the curvature guard and the first-step scaling in [`bfgs`], the
+//! backtracking cap in [`armijo`], the step cap in [`BfgsConfig`].
+
+pub mod armijo;
+pub mod bfgs;
+pub mod gd;
+
+use core::fmt;
+
+use heapless::Vec;
+use nalgebra::SVector;
+
+pub use armijo::{Armijo, LineSearch, Trial};
+pub use bfgs::{BfgsConfig, bfgs};
+pub use gd::{GdConfig, gradient_descent};
+
+/// A function to minimize: its value and gradient at a point.
+///
+/// For the planner the point is a vector of reference depths (m), the
+/// value `J` (m³) and the gradient `∂J/∂z` (m²).
+pub trait Objective<const K: usize> {
+    /// Why an evaluation failed.
+    type Error;
+    /// Value and gradient at `z`.
+    ///
+    /// # Errors
+    /// When the function cannot be evaluated at `z` (for the planner: the
+    /// simulation diverged).
+    fn eval(&mut self, z: &SVector<f32, K>) -> Result<(f32, SVector<f32, K>), Self::Error>;
+}
+
+/// Box constraint `lo <= z <= hi`, enforced by projection (clamping) of
+/// every trial point. A variable with `lo == hi` is pinned.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds<const K: usize> {
+    /// Lower bounds.
+    pub lo: SVector<f32, K>,
+    /// Upper bounds.
+    pub hi: SVector<f32, K>,
+}
+
+impl<const K: usize> Bounds<K> {
+    /// The same interval `[lo, hi]` for every variable.
+    pub fn uniform(lo: f32, hi: f32) -> Self {
+        Self {
+            lo: SVector::repeat(lo),
+            hi: SVector::repeat(hi),
+        }
+    }
+
+    /// `z` clamped into the box.
+    pub fn project(&self, z: &SVector<f32, K>) -> SVector<f32, K> {
+        z.zip_zip_map(&self.lo, &self.hi, |v, lo, hi| v.max(lo).min(hi))
+    }
+
+    /// Whether variable `i` can move in the direction `-g[i]`: neither
+    /// pinned nor pushed against the bound it sits on.
+    pub fn free(&self, z: &SVector<f32, K>, g: &SVector<f32, K>, i: usize) -> bool {
+        let (Some(&v), Some(&lo), Some(&hi), Some(&gi)) =
+            (z.get(i), self.lo.get(i), self.hi.get(i), g.get(i))
+        else {
+            return false;
+        };
+        lo < hi && !(v <= lo && gi > 0.0) && !(v >= hi && gi < 0.0)
+    }
+
+    /// The gradient with the components of non-free variables zeroed:
+    /// its norm is the projected-gradient stopping measure.
+    pub fn free_gradient(&self, z: &SVector<f32, K>, g: &SVector<f32, K>) -> SVector<f32, K> {
+        SVector::from_fn(|i, _| {
+            if self.free(z, g, i) {
+                g.get(i).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            }
+        })
+    }
+
+    /// `true` when every bound is finite and `lo <= hi`.
+    pub fn is_valid(&self) -> bool {
+        self.lo
+            .iter()
+            .zip(self.hi.iter())
+            .all(|(l, h)| l.is_finite() && h.is_finite() && l <= h)
+    }
+}
+
+/// Why an optimizer stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Status {
+    /// A stopping rule held (paper 3.14a or 3.14b, see [`Tolerances`]).
+    Converged,
+    /// The iteration cap was reached first.
+    MaxIterations,
+    /// No step along the search direction decreased the objective enough
+    /// within the backtracking cap (BFGS), or an evaluation failed (GD).
+    LineSearchFailed,
+}
+
+impl Status {
+    /// The name the host tool prints.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            Self::Converged => "converged",
+            Self::MaxIterations => "max_iterations",
+            Self::LineSearchFailed => "line_search_failed",
+        }
+    }
+}
+
+impl fmt::Display for Status {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// Stopping rules, paper eq. 3.14 made scale-aware:
+/// - (a) `‖G‖ <= grad` on the free variables (`GᵀG <= ε1` with
+///   `ε1 = grad²`), m²;
+/// - (b) `|J_{i+1} − J_i| <= rel · max(|J_i|, floor)`; BFGS also stops
+///   before a step when its quadratic model predicts a decrease
+///   `−½ Gᵀs` below that same threshold (the step would be wasted).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Tolerances {
+    /// Gradient norm, m² (objective m³ per m of depth).
+    pub grad: f32,
+    /// Relative change of the objective.
+    pub rel: f32,
+    /// Objective floor for the relative test, m³.
+    pub floor: f32,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Self {
+            grad: 1e-3,
+            rel: 1e-5,
+            floor: 1.0,
+        }
+    }
+}
+
+impl Tolerances {
+    /// The 3.14b threshold at objective value `j`.
+    pub fn j_threshold(&self, j: f32) -> f32 {
+        self.rel * libm::fabsf(j).max(self.floor)
+    }
+
+    fn is_valid(&self) -> bool {
+        self.grad.is_finite()
+            && self.grad >= 0.0
+            && self.rel.is_finite()
+            && self.rel >= 0.0
+            && self.floor.is_finite()
+            && self.floor > 0.0
+    }
+}
+
+/// How many objective values an [`Outcome`] keeps (the first ones).
+pub const HISTORY: usize = 256;
+
+/// Result of an optimization: where it stopped, why, and what it cost.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Outcome<const K: usize> {
+    /// The last accepted point.
+    pub z: SVector<f32, K>,
+    /// Objective there.
+    pub j: f32,
+    /// Gradient there.
+    pub gradient: SVector<f32, K>,
+    /// Norm of the gradient on the free variables.
+    pub grad_norm: f32,
+    /// Why it stopped.
+    pub status: Status,
+    /// Iterations taken (accepted steps).
+    pub iterations: u32,
+    /// Objective-and-gradient evaluations, the start included.
+    pub evaluations: u32,
+    /// BFGS updates skipped by the curvature guard.
+    pub skipped_updates: u32,
+    /// The objective at the start and after each iteration (the first
+    /// [`HISTORY`] values).
+    pub history: Vec<f32, HISTORY>,
+}
+
+/// Why an optimizer could not start.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum OptimError<E> {
+    /// A configuration value is out of range (named).
+    Config(&'static str),
+    /// The objective could not be evaluated at the starting point.
+    Start(E),
+    /// The objective or gradient at the starting point is not finite.
+    NonFinite,
+}
+
+impl<E: fmt::Display> fmt::Display for OptimError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Self::Config(p) => write!(f, "optimizer setting {p} is out of range"),
+            Self::Start(e) => write!(f, "objective failed at the start: {e}"),
+            Self::NonFinite => f.write_str("objective not finite at the start"),
+        }
+    }
+}
+
+impl<E: fmt::Debug + fmt::Display> core::error::Error for OptimError<E> {}
+
+/// Evaluates at the start point, checking finiteness.
+fn start<const K: usize, O: Objective<K>>(
+    obj: &mut O,
+    z: &SVector<f32, K>,
+) -> Result<(f32, SVector<f32, K>), OptimError<O::Error>> {
+    let (j, g) = obj.eval(z).map_err(OptimError::Start)?;
+    if j.is_finite() && g.iter().all(|v| v.is_finite()) {
+        Ok((j, g))
+    } else {
+        Err(OptimError::NonFinite)
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod testfns {
+    //! Test functions shared by the optimizer tests.
+    use super::Objective;
+    use nalgebra::{SMatrix, SVector};
+
+    /// Rosenbrock's function, minimum 0 at (1, 1).
+    pub struct Rosenbrock {
+        pub evals: u32,
+    }
+    impl Objective<2> for Rosenbrock {
+        type Error = ();
+        fn eval(&mut self, z: &SVector<f32, 2>) -> Result<(f32, SVector<f32, 2>), ()> {
+            self.evals += 1;
+            let (x, y) = (z[0], z[1]);
+            let j = (1.0 - x) * (1.0 - x) + 100.0 * (y - x * x) * (y - x * x);
+            let g = SVector::<f32, 2>::new(
+                -2.0 * (1.0 - x) - 400.0 * x * (y - x * x),
+                200.0 * (y - x * x),
+            );
+            Ok((j, g))
+        }
+    }
+
+    /// `½ zᵀ H z − bᵀ z`.
+    pub struct Quadratic<const K: usize> {
+        pub h: SMatrix<f32, K, K>,
+        pub b: SVector<f32, K>,
+    }
+    impl<const K: usize> Objective<K> for Quadratic<K> {
+        type Error = ();
+        fn eval(&mut self, z: &SVector<f32, K>) -> Result<(f32, SVector<f32, K>), ()> {
+            let hz = self.h * z;
+            Ok((0.5 * z.dot(&hz) - self.b.dot(z), hz - self.b))
+        }
+    }
+}
