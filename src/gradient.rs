@@ -194,17 +194,37 @@ impl<const N: usize, const S: usize, const W: usize> Scenario<'_, N, S, W> {
         first_track: usize,
         depths: &[f32; K],
     ) -> Result<Evaluation<N, K>, SimError> {
+        self.evaluate_tracks(start, first_track, depths, K)
+    }
+
+    /// As [`Scenario::evaluate`], over the first `count <= K` of the depths
+    /// only (a horizon cut short by the end of the line): the remaining
+    /// entries are ignored, their gradients are zero and their scores
+    /// default.
+    ///
+    /// # Errors
+    /// As [`Scenario::evaluate`]; [`SimError::TrackRange`] when `count` is 0
+    /// or above `K`.
+    pub fn evaluate_tracks<const K: usize>(
+        &self,
+        start: &VehicleState<N>,
+        first_track: usize,
+        depths: &[f32; K],
+        count: usize,
+    ) -> Result<Evaluation<N, K>, SimError> {
+        let used = depths.get(..count).ok_or(SimError::TrackRange)?;
         let mut scores = [TrackScore::default(); K];
         let mut tan = Tangents::<N, K>::zero();
-        let end = self.run(start, first_track, depths, &mut scores, &mut tan, |_| {})?;
+        let end = self.run(start, first_track, used, &mut scores, &mut tan, |_| {})?;
         let grad_j: [f32; K] = tan.grad_j.into();
         let grad_violation: [f32; K] = tan.grad_violation.into();
         if !grad_j.iter().chain(&grad_violation).all(|g| g.is_finite()) {
             return Err(SimError::Diverged);
         }
-        let j = scores.iter().map(TrackScore::j).sum();
-        let violation = scores.iter().map(TrackScore::violation).sum();
-        let min_altitude = scores
+        let used_scores = scores.get(..count).unwrap_or(&[]);
+        let j = used_scores.iter().map(TrackScore::j).sum();
+        let violation = used_scores.iter().map(TrackScore::violation).sum();
+        let min_altitude = used_scores
             .iter()
             .map(TrackScore::min_altitude)
             .fold(f32::INFINITY, f32::min);

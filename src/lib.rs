@@ -63,6 +63,7 @@ pub mod expm;
 pub mod gradient;
 mod num;
 pub mod optim;
+pub mod planner;
 pub mod plant;
 pub mod profile;
 pub mod sim;
@@ -72,6 +73,7 @@ pub use autopilot::{Autopilot, AutopilotConfig, AutopilotState, Command, PidGain
 pub use error::{ConfigError, Error};
 pub use gradient::Evaluation;
 pub use plant::{Plant, PlantError, TfKind, TransferFunction};
+pub use planner::{Method, Mode, Plan, PlanError, PlanStatus, Planner, PlannerConfig};
 pub use profile::{Profile, ProfileError};
 pub use sim::{Sample, Scenario, SimError, TrackScore, VehicleState, WaypointError, Waypoints};
 pub use vehicle::{Mission, Vehicle, VehicleConfig};

@@ -372,9 +372,10 @@ impl TrackScore {
     pub fn rms(&self) -> f32 {
         libm::sqrtf(2.0 * self.j() / (self.x_end - self.x_start))
     }
-    /// Constraint violation `½ ∫ max(0, h_a − h)² dx` by the same
-    /// trapezoid, m³; zero when the altitude never drops below `h_a`
-    /// at a scored point.
+    /// Constraint violation `½ ∫ max(0, h_p − h)² dx` by the same
+    /// trapezoid, m³, with `h_p` the scenario's penalty altitude (`h_a`
+    /// unless set otherwise); zero when the altitude never drops below
+    /// `h_p` at a scored point.
     pub fn violation(&self) -> f32 {
         self.violation.value()
     }
@@ -469,6 +470,8 @@ pub struct Scenario<'a, const N: usize, const S: usize, const W: usize> {
     profile: &'a Profile<S>,
     waypoints: &'a Waypoints<W>,
     mission: Mission,
+    /// Altitude the violation measure is taken against, m (default `h_a`).
+    penalty_altitude: f32,
     /// `b(X_i)`, m.
     wp_bottom: Vec<f32, W>,
 }
@@ -498,9 +501,25 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
             vehicle,
             profile,
             waypoints,
+            penalty_altitude: mission.min_altitude(),
             mission,
             wp_bottom,
         })
+    }
+
+    /// The same scenario with the violation measure
+    /// ([`TrackScore::violation`]) taken against `altitude` (m) instead of
+    /// `h_a`: a planner penalizes a little above `h_a` to keep a margin.
+    pub fn with_penalty_altitude(mut self, altitude: f32) -> Self {
+        if altitude.is_finite() {
+            self.penalty_altitude = altitude;
+        }
+        self
+    }
+
+    /// The altitude the violation measure is taken against, m.
+    pub fn penalty_altitude(&self) -> f32 {
+        self.penalty_altitude
     }
 
     /// The vehicle.
@@ -829,7 +848,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         End {
             at,
             e: h - self.mission.reference_altitude(),
-            p: (self.mission.min_altitude() - h).max(0.0),
+            p: (self.penalty_altitude - h).max(0.0),
         }
     }
 }

@@ -98,10 +98,11 @@ impl Args {
                 "--horizon" => {
                     let v = value("--horizon")?;
                     match v.trim().parse::<usize>() {
-                        Ok(k) if k >= 1 => a.horizon = Some(k),
+                        Ok(k) if (1..=crate::MAX_HORIZON).contains(&k) => a.horizon = Some(k),
                         _ => {
                             return Err(Fail::usage(format!(
-                                "--horizon must be a whole number of tracks >= 1, got '{v}'"
+                                "--horizon must be a whole number of tracks from 1 to {}, got '{v}'",
+                                crate::MAX_HORIZON
                             )));
                         }
                     }

@@ -159,12 +159,30 @@ struct FilePlant {
 #[serde(deny_unknown_fields)]
 struct FileOptimizer {
     max_iterations: Option<u32>,
+    gd_rate: Option<f64>,
+    scan_points: Option<u32>,
 }
 
-/// Optimizer settings from `[optimizer]`.
+/// Optimizer settings from `[optimizer]` (every key optional).
 #[derive(Clone, Copy, Debug)]
 pub struct OptimizerSettings {
     pub max_iterations: u32,
+    pub gd_rate: Option<f32>,
+    pub scan_points: Option<u32>,
+}
+
+impl OptimizerSettings {
+    /// The planner settings with these overrides.
+    pub fn apply(&self, mut pc: auvnav::PlannerConfig) -> auvnav::PlannerConfig {
+        pc.bfgs.max_iterations = self.max_iterations;
+        if let Some(r) = self.gd_rate {
+            pc.gd_rate = r;
+        }
+        if let Some(n) = self.scan_points {
+            pc.scan_points = n;
+        }
+        pc
+    }
 }
 
 /// Everything the config file sets, resolved against the defaults.
@@ -283,7 +301,14 @@ pub fn config(text: Option<(&str, &str)>) -> Result<Config, Fail> {
         plant,
         mission,
         initial_depth,
-        optimizer: OptimizerSettings { max_iterations },
+        optimizer: OptimizerSettings {
+            max_iterations,
+            gd_rate: match opt.gd_rate {
+                None => None,
+                Some(v) => Some(num(Some(v), 0.0, "optimizer.gd_rate", name)?),
+            },
+            scan_points: opt.scan_points,
+        },
     })
 }
 

@@ -14,9 +14,9 @@ mod report;
 
 use std::process::ExitCode;
 
-use auvnav::{Profile, Scenario, TrackScore, Vehicle, Waypoints};
+use auvnav::{Method, Mode, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle, Waypoints};
 
-use args::{Args, Mode};
+use args::Args;
 use fail::Fail;
 use report::{Report, TrackReport, TrajRow};
 
@@ -24,6 +24,8 @@ use report::{Report, TrackReport, TrajRow};
 const SAMPLES: usize = 20_000;
 /// Waypoint capacity of the host tool.
 const WAYPOINTS: usize = 256;
+/// Most tracks the host tool optimizes jointly in horizon mode.
+pub const MAX_HORIZON: usize = 8;
 
 fn main() -> ExitCode {
     match run(Args::parse(std::env::args().skip(1))) {
@@ -92,14 +94,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
                 optimizer: vec![Effort::fixed(); tracks],
             }
         }
-        None => {
-            let _ = (args.method, args.mode == Mode::Horizon, args.horizon);
-            let _ = (args.unconstrained, cfg.optimizer.max_iterations);
-            return Err(Fail::usage(
-                "optimization modes are not yet implemented; give --depths z1,...,zM to evaluate a plan"
-                    .into(),
-            ));
-        }
+        None => plan_line(&args, &cfg, &scenario, initial_depth)?,
     };
     if args.plot.is_some() {
         return Err(Fail::usage("--plot is not yet implemented".into()));
@@ -160,6 +155,60 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         print!("{}", report.table());
     }
     Ok(())
+}
+
+/// Plans the whole line track by track, each from the state in which the
+/// vehicle reaches its first waypoint.
+fn plan_line(
+    args: &Args,
+    cfg: &input::Config,
+    scenario: &Scenario<'_, { input::ORDER }, SAMPLES, WAYPOINTS>,
+    initial_depth: f32,
+) -> Result<Plan, Fail> {
+    let pc = PlannerConfig {
+        method: match args.method {
+            args::Method::Bfgs => Method::Bfgs,
+            args::Method::Gd => Method::GradientDescent,
+        },
+        mode: match args.mode {
+            args::Mode::Horizon => Mode::Horizon,
+            args::Mode::Track => Mode::TrackWise,
+        },
+        horizon: args.horizon.unwrap_or(usize::MAX),
+        constrained: !args.unconstrained,
+        ..cfg.optimizer.apply(PlannerConfig::default())
+    };
+    let mut planner =
+        Planner::<MAX_HORIZON>::new(pc).map_err(|e| Fail::input(format!("config: {e}")))?;
+    let mut state = scenario.start_state(initial_depth);
+    let tracks = scenario.waypoints().tracks();
+    let mut depths = Vec::with_capacity(tracks);
+    let mut optimizer = Vec::with_capacity(tracks);
+    for n in 0..tracks {
+        let p = planner
+            .plan(scenario, &state, n)
+            .map_err(|e| Fail::input(format!("planning track {}: {e}", n + 1)))?;
+        depths.push(p.depth);
+        optimizer.push(Effort {
+            iterations: p.iterations,
+            evaluations: p.evaluations,
+            status: p.status.as_str(),
+            j_history: p.history.to_vec(),
+        });
+        state = p.next_state;
+    }
+    Ok(Plan {
+        method: match args.method {
+            args::Method::Bfgs => "bfgs",
+            args::Method::Gd => "gd",
+        },
+        mode: match args.mode {
+            args::Mode::Horizon => "horizon",
+            args::Mode::Track => "track",
+        },
+        depths,
+        optimizer,
+    })
 }
 
 /// The depths to fly and how they were found.
