@@ -10,11 +10,14 @@
 mod args;
 mod fail;
 mod input;
+mod plot;
 mod report;
 
 use std::process::ExitCode;
 
-use auvnav::{Method, Mode, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle, Waypoints};
+use auvnav::{
+    Method, Mode, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle, Waypoints,
+};
 
 use args::Args;
 use fail::Fail;
@@ -96,15 +99,12 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         }
         None => plan_line(&args, &cfg, &scenario, initial_depth)?,
     };
-    if args.plot.is_some() {
-        return Err(Fail::usage("--plot is not yet implemented".into()));
-    }
 
     // The flight the reported depths produce, scored track by track.
     let start = scenario.start_state(initial_depth);
     let mut scores = vec![TrackScore::default(); tracks];
     let mut rows = Vec::new();
-    let record = args.trajectory.is_some();
+    let record = args.trajectory.is_some() || args.plot.is_some();
     let h_r = cfg.mission.reference_altitude();
     scenario
         .simulate(&start, 0, &report_base.depths, &mut scores, |s| {
@@ -148,6 +148,28 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     };
     if let Some(path) = &args.trajectory {
         report::write_trajectory(path, &rows)?;
+    }
+    if let Some(path) = &args.plot {
+        plot::draw(
+            path,
+            &plot::Figure {
+                title: format!(
+                    "{} — {} / {}, total J {:.4e} m³, min altitude {:.2} m",
+                    profile_name,
+                    report.method,
+                    report.mode,
+                    report.total_j(),
+                    report.min_altitude()
+                ),
+                profile_x: profile.positions(),
+                profile_b: profile.depths(),
+                waypoints: waypoints.positions(),
+                reference_altitude: h_r,
+                min_altitude: h_a,
+                rows: &rows,
+                report: &report,
+            },
+        )?;
     }
     if args.json {
         println!("{}", report.json());
