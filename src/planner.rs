@@ -409,16 +409,24 @@ impl<const K: usize> Planner<K> {
         } else {
             self.cfg.bfgs.first_step
         };
-        let mut outcome = self.optimize(&mut obj, &z0, &bounds, first_step)?;
+        let cap = self.cfg.bfgs.max_iterations;
+        let mut outcome = self.optimize(&mut obj, &z0, &bounds, first_step, cap)?;
         let mut iterations = outcome.iterations;
         // One track: the verification's bisection finds the safe boundary
         // exactly, a stiffer penalty stage would only cost iterations.
         let stages = if h == 1 { 1 } else { self.cfg.penalty_stages };
         let max_mu =
             self.cfg.penalty_weight * libm::powf(PENALTY_GROWTH, stages.saturating_sub(1) as f32);
-        while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 {
+        // The iteration cap bounds the whole solve, all stages together.
+        while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 && iterations < cap {
             obj.mu *= PENALTY_GROWTH;
-            let next = self.optimize(&mut obj, &outcome.z, &bounds, first_step)?;
+            let next = self.optimize(
+                &mut obj,
+                &outcome.z,
+                &bounds,
+                first_step,
+                cap.saturating_sub(iterations),
+            )?;
             iterations = iterations.saturating_add(next.iterations);
             let mut history = outcome.history;
             for &v in next.history.iter().skip(1) {
@@ -508,9 +516,11 @@ impl<const K: usize> Planner<K> {
         z0: &SVector<f32, K>,
         bounds: &Bounds<K>,
         first_step: f32,
+        max_iterations: u32,
     ) -> Result<Outcome<K>, PlanError> {
         let bfgs = BfgsConfig {
             first_step,
+            max_iterations,
             ..self.cfg.bfgs
         };
         let out = match self.cfg.method {
@@ -518,7 +528,7 @@ impl<const K: usize> Planner<K> {
             Method::GradientDescent => {
                 let gd = GdConfig {
                     rate: self.cfg.gd_rate,
-                    max_iterations: self.cfg.bfgs.max_iterations,
+                    max_iterations,
                     tol: self.cfg.bfgs.tol,
                 };
                 optim::gradient_descent(obj, z0, bounds, &gd)

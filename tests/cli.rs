@@ -3,7 +3,8 @@
 //! object and trajectory CSV the spec fixes.
 //!
 //! `cargo test` builds the examples before it runs the tests, so the tool
-//! is found beside this test binary.
+//! is found beside this test binary. (A filtered `cargo test --test cli`
+//! does not rebuild it: run `cargo build --example plan` first.)
 
 // Test code: a failed unwrap or index is a failed test.
 #![allow(
@@ -246,6 +247,7 @@ fn bad_command_lines() {
     bad(&["--method", "newton"], "--method");
     bad(&["--mode", "sideways"], "--mode");
     bad(&["--horizon", "0"], "--horizon");
+    bad(&["--horizon", "9"], "from 1 to 8");
     bad(&["--frobnicate"], "unknown argument");
     bad(&["--profile", "p.csv"], "--waypoints");
     bad(&["--depths"], "needs a value");
@@ -335,4 +337,102 @@ fn trajectory_csv_has_every_sample() {
     let switch = rows.iter().position(|r| r[6] == "15").unwrap();
     assert!(rows[switch][0].parse::<f32>().unwrap() >= 150.0);
     assert!(rows[switch - 1][0].parse::<f32>().unwrap() < 150.0);
+}
+
+#[test]
+fn planning_modes_report_the_optimizer() {
+    for mode in ["track", "horizon"] {
+        for method in ["bfgs", "gd"] {
+            let v = json_of(&["--mode", mode, "--method", method, "--json"]);
+            assert_eq!(v["method"], method);
+            assert_eq!(v["mode"], mode);
+            for t in v["tracks"].as_array().unwrap() {
+                let status = t["status"].as_str().unwrap();
+                assert!(
+                    [
+                        "converged",
+                        "max_iterations",
+                        "line_search_failed",
+                        "safe_fallback",
+                        "infeasible"
+                    ]
+                    .contains(&status),
+                    "{status}"
+                );
+                let it = t["iterations"].as_u64().unwrap();
+                let ev = t["evaluations"].as_u64().unwrap();
+                let hist = t["J_history"].as_array().unwrap();
+                // The start, then one value per iteration (the first 256).
+                assert_eq!(hist.len() as u64, (it + 1).min(256));
+                assert!(it <= 200, "the iteration cap bounds the whole solve");
+                assert!(
+                    ev > it,
+                    "{mode} {method}: {ev} evaluations for {it} iterations"
+                );
+                // infeasible is reported unsafe; a safe track is never infeasible.
+                if status == "infeasible" {
+                    assert!(t["min_altitude"].as_f64().unwrap() < 60.0 + 0.01 + 1e-6);
+                }
+                if t["safe"] == true {
+                    assert!(t["min_altitude"].as_f64().unwrap() >= 60.0);
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn unconstrained_ignores_the_minimum_altitude() {
+    let bare = json_of(&["--mode", "track", "--unconstrained", "--json"]);
+    let safe = json_of(&["--mode", "track", "--json"]);
+    // From the same start, the bare objective tracks the target more
+    // closely on track 1 and flies lower (later tracks start elsewhere).
+    let (b1, s1) = (&bare["tracks"][0], &safe["tracks"][0]);
+    assert!(b1["J"].as_f64().unwrap() < s1["J"].as_f64().unwrap());
+    assert!(b1["min_altitude"].as_f64().unwrap() < 60.0);
+    assert!(s1["min_altitude"].as_f64().unwrap() >= 60.0);
+    for t in bare["tracks"].as_array().unwrap() {
+        assert_ne!(t["status"], "safe_fallback");
+        assert_ne!(t["status"], "infeasible");
+    }
+}
+
+#[test]
+fn plot_writes_an_svg_figure() {
+    let dir = std::env::temp_dir().join(format!("auvnav-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("f.svg");
+    let o = run(&["--mode", "track", "--plot", out.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(svg.starts_with("<svg"));
+    for label in [
+        "bottom b(x)",
+        "minimum-altitude envelope",
+        "AUV flight",
+        "objective against iteration",
+    ] {
+        assert!(svg.contains(label), "figure lacks {label}");
+    }
+    assert!(svg.len() < 200_000, "{} bytes", svg.len());
+}
+
+#[test]
+fn main_job_prints_a_table() {
+    let out = run(&[]);
+    assert_eq!(out.status.code(), Some(0));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.starts_with("method bfgs, mode horizon"), "{text}");
+    assert_eq!(
+        text.lines()
+            .filter(|l| l.trim_start().starts_with(char::is_numeric))
+            .count(),
+        5
+    );
+    assert!(text.contains("total J"));
 }

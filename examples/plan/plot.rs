@@ -158,14 +158,18 @@ fn draw_inner(path: &Path, fig: &Figure<'_>) -> Result<(), Box<dyn std::error::E
         Circle::new((w, d), 4, BLACK.filled())
     }))?;
     let blue = RGBColor(20, 60, 200);
+    // At most ~2000 points: a 0.15 m step is far below a pixel.
+    let stride = (fig.rows.len() / 2000).max(1);
+    let last = fig.rows.len().saturating_sub(1);
+    let flight: Vec<(f32, f32)> = fig
+        .rows
+        .iter()
+        .enumerate()
+        .filter(|(i, r)| in_line(r.x) && (i % stride == 0 || *i == last))
+        .map(|(_, r)| (r.x, r.depth))
+        .collect();
     chart
-        .draw_series(LineSeries::new(
-            fig.rows
-                .iter()
-                .filter(|r| in_line(r.x))
-                .map(|r| (r.x, r.depth)),
-            blue.stroke_width(2),
-        ))?
+        .draw_series(LineSeries::new(flight, blue.stroke_width(2)))?
         .label("AUV flight d(x)")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2)));
     chart

@@ -437,6 +437,13 @@ def search_track(fm: Fast, S, n, k_best=6, n_coarse=201, n_fine=600, tol_z=0.005
 # --------------------------------------------------------------------------
 
 
+def zscale(fm: Fast):
+    """Depth scale of the local searches: max(h_r, 20 m) / 80 (1 m at the
+    paper's h_r = 80 m; 0.25 m on the shallow sites, whose optimal depths
+    still move by metres)."""
+    return max(fm.h_r, 20.0) / 80.0
+
+
 def _track_band(fm: Fast, n):
     """Bottom depth range over track n (profile samples and the ends)."""
     a, b = fm.X[n - 1], fm.X[n]
@@ -534,7 +541,7 @@ def beam_search(fm: Fast, B=100, nz=32, seed=0, center=None, halfwidth=None):
 
 def refine_plan(fm: Fast, z, max_sweeps=4):
     """Cyclic coordinate search on a safe plan: for each track in turn try
-    z_n + {+-0.03, 0.1, 0.3, 1, 3, 10, 30} x h_r/80 m (the later tracks
+    z_n + {+-0.03, 0.1, 0.3, 1, 3, 10, 30} x zscale m (the later tracks
     re-flown), keep the best safe improvement; repeat until a sweep finds
     nothing."""
     z = np.array(z, dtype=float)
@@ -543,7 +550,7 @@ def refine_plan(fm: Fast, z, max_sweeps=4):
     h_a = fm.h_a
     assert (hs >= h_a).all()
     total = float(Js.sum())
-    base = np.array([0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0]) * fm.h_r / 80.0
+    base = np.array([0.03, 0.1, 0.3, 1.0, 3.0, 10.0, 30.0]) * zscale(fm)
     deltas = np.concatenate((-base[::-1], base))
     n_eval = 0
     for _sweep in range(max_sweeps):
@@ -572,7 +579,7 @@ def refine_plan(fm: Fast, z, max_sweeps=4):
 def best_horizon_plan(fm: Fast, B=100, nz=32, seed=0, focus=(20.0, 5.0, 1.25, 0.3),
                       sweeps=1):
     """Wide beam search, then focused beam passes around the best plan so far
-    (half-widths `focus` x h_r/80 m), then a coordinate-search polish."""
+    (half-widths `focus` x zscale m), then a coordinate-search polish."""
     res = beam_search(fm, B=B, nz=nz, seed=seed)
     if not res["safe_plan"]:
         return res
@@ -580,7 +587,7 @@ def best_horizon_plan(fm: Fast, B=100, nz=32, seed=0, focus=(20.0, 5.0, 1.25, 0.
     best = res
     for k, hw in enumerate(focus):
         r = beam_search(fm, B=B, nz=nz, seed=seed + 1 + k, center=best["plan"],
-                        halfwidth=hw * fm.h_r / 80.0)
+                        halfwidth=hw * zscale(fm))
         res["evaluations"] += r["evaluations"]
         res["passes"].append(r["total_J"] if r["safe_plan"] else None)
         if r["safe_plan"] and r["total_J"] < best["total_J"]:
@@ -596,3 +603,639 @@ def best_horizon_plan(fm: Fast, B=100, nz=32, seed=0, focus=(20.0, 5.0, 1.25, 0.
                        total_J=r["total_J"])
         out["passes"].append(out["total_J"])
     return out
+
+
+# --------------------------------------------------------------------------
+# Cases: the six shared profiles and random unseen ones
+# --------------------------------------------------------------------------
+
+
+def unseen_case(seed, i):
+    """A random-walk bottom (slopes up to 45 deg, depth 200-1500 m, 10 m
+    sampling) under 4-5 tracks of 300-900 m; h_r/h_a 80/60."""
+    rng = random.Random(f"planner/{seed}/{i}")
+    M = rng.randint(4, 5)
+    X = [0.0]
+    for _ in range(M):
+        X.append(X[-1] + round(rng.uniform(300.0, 900.0), 1))
+    ds = 10.0
+    n = int(math.ceil(X[-1] / ds)) + 1
+    xs = [k * ds for k in range(n + 1)]
+    b = rng.uniform(400.0, 1300.0)
+    ang = rng.uniform(-25.0, 25.0)
+    sd = rng.uniform(2.0, 8.0)
+    bs = [round(b, 2)]
+    for _ in range(n):
+        ang = max(-45.0, min(45.0, ang + rng.gauss(0.0, sd)))
+        if rng.random() < 0.03:  # a flat stretch or a sharp break now and then
+            ang = 0.0 if rng.random() < 0.5 else rng.uniform(-45.0, 45.0)
+        nb = b + math.tan(math.radians(ang)) * ds
+        if not 200.0 <= nb <= 1500.0:
+            ang = -ang
+            nb = min(1500.0, max(200.0, b + math.tan(math.radians(ang)) * ds))
+        b = nb
+        bs.append(round(b, 2))
+    return {"name": f"unseen_{seed}_{i}", "xs": xs, "bs": bs, "X": X,
+            "h_r": 80.0, "h_a": 60.0}
+
+
+def write_case(case, base):
+    """Write (or point at) PROFILE.csv, WAYPOINTS.csv and VEHICLE.toml."""
+    d = os.path.join(base, case["name"])
+    os.makedirs(d, exist_ok=True)
+    if "xs" in case:
+        P = os.path.join(d, "PROFILE.csv")
+        W = os.path.join(d, "WAYPOINTS.csv")
+        check_plan.write_profile(P, case["xs"], case["bs"])
+        check_plan.write_waypoints(W, case["X"])
+    else:
+        P = os.path.join(DATA, case["name"] + ".csv")
+        W = os.path.join(DATA, case["name"] + ".waypoints.csv")
+    V = os.path.join(d, "VEHICLE.toml")
+    check_plan.write_toml(V, {"reference_altitude": case["h_r"], "min_altitude": case["h_a"]})
+    case.update(P=P, W=W, V=V, dir=d)
+    return case
+
+
+# --------------------------------------------------------------------------
+# The tool and its output
+# --------------------------------------------------------------------------
+
+# (key, --mode, --method, --unconstrained)
+RUNS = [
+    ("track_unconstrained_bfgs", "track", "bfgs", True),
+    ("track_constrained_bfgs", "track", "bfgs", False),
+    ("horizon_bfgs", "horizon", "bfgs", False),
+    ("track_unconstrained_gd", "track", "gd", True),
+]
+
+
+def tool_args(case, mode, method, unconstrained):
+    a = ["--profile", case["P"], "--waypoints", case["W"], "--config", case["V"],
+         "--mode", mode, "--method", method]
+    if unconstrained:
+        a.append("--unconstrained")
+    return a + ["--json"]
+
+
+class ToolRunner:
+    def __init__(self, cmd, cwd, timeout):
+        self.cmd0 = shlex.split(cmd)
+        self.cwd = cwd
+        self.timeout = timeout
+
+    def __call__(self, case, key, mode, method, unconstrained):
+        """(parsed JSON or None, error message, seconds, command line)."""
+        args = self.cmd0 + tool_args(case, mode, method, unconstrained)
+        t0 = time.time()
+        try:
+            p = subprocess.run(args, cwd=self.cwd, capture_output=True, text=True,
+                               timeout=self.timeout)
+        except (OSError, subprocess.TimeoutExpired) as e:
+            return None, f"could not run: {e}", time.time() - t0, shlex.join(args)
+        dt = time.time() - t0
+        if p.returncode != 0:
+            err = (p.stderr.strip().splitlines() or ["(no stderr)"])[-1]
+            return None, f"exit status {p.returncode}: {err}", dt, shlex.join(args)
+        try:
+            return json.loads(p.stdout), "", dt, shlex.join(args)
+        except json.JSONDecodeError as e:
+            return None, f"stdout is not one JSON object: {e}", dt, shlex.join(args)
+
+
+def plan_json(fm: Fast, depths, mode, method, statuses=None, iterations=None):
+    """The cli.md JSON of a plan, scored by auvref (the scalar reference)."""
+    _, res = ar.evaluate_plan(fm.v, fm.prof, fm.X, depths)
+    h_a = fm.h_a
+    tracks = []
+    for i, (t, z) in enumerate(zip(res["tracks"], depths)):
+        tracks.append({
+            "track": t["track"], "x_start": t["x_start"], "x_end": t["x_end"],
+            "depth": float(z), "J": t["J"], "rms": t["rms"],
+            "min_altitude": t["min_altitude"], "safe": t["min_altitude"] >= h_a,
+            "iterations": iterations[i] if iterations else 0,
+            "evaluations": 2 * (iterations[i] if iterations else 0),
+            "status": statuses[i] if statuses else "converged",
+            "J_history": [t["J"]],
+        })
+    return {"method": method, "mode": mode, "tracks": tracks, "total_J": res["total_J"],
+            "min_altitude": res["min_altitude"], "safe": res["min_altitude"] >= h_a}
+
+
+# --------------------------------------------------------------------------
+# The checks
+# --------------------------------------------------------------------------
+
+
+def _g(v, p=6):
+    return "None" if v is None else f"{v:.{p}g}"
+
+
+class CaseChecker:
+    """Everything about one profile: the model, cached searches, the checks."""
+
+    def __init__(self, case, beam=100, nz=32, seed=0):
+        self.case = case
+        self.name = case["name"]
+        prof = ref_plan.load_profile(case["P"])
+        X = ref_plan.load_waypoints(case["W"])
+        self.vehicle = ar.Vehicle.from_config(ref_plan.load_config(case["V"]))
+        self.fm = Fast(self.vehicle, prof, X)
+        self.h_a = self.vehicle.min_altitude
+        self.beam, self.nz, self.seed = beam, nz, seed
+        self._search = {}
+        self._horizon = None
+        self.checks = []  # (ok, line)
+        self.info = []
+        self.consistency = []  # (max rel J, max |h|) of auvref vs Fast
+        self.data = {"name": self.name, "h_r": self.vehicle.reference_altitude,
+                     "h_a": self.h_a, "waypoints": X, "runs": {}}
+
+    # ---- cached searches ----
+    def search(self, S, n):
+        key = (n, tuple(np.round(np.asarray(S).ravel(), 7)))
+        if key not in self._search:
+            self._search[key] = search_track(self.fm, S, n)
+        return self._search[key]
+
+    def horizon(self):
+        if self._horizon is None:
+            self._horizon = best_horizon_plan(self.fm, B=self.beam, nz=self.nz, seed=self.seed)
+        return self._horizon
+
+    def add(self, ok, what, msg):
+        line = f"{'ok  ' if ok else 'FAIL'} {what} {self.name}: {msg}"
+        self.checks.append((bool(ok), line))
+        return ok
+
+    # ---- helpers ----
+    def parse(self, out):
+        """(depths, tracks) of a tool's JSON, or raise ValueError."""
+        tr = out["tracks"]
+        if len(tr) != self.fm.M:
+            raise ValueError(f"{len(tr)} tracks, expected {self.fm.M}")
+        depths = []
+        for n, t in enumerate(tr, 1):
+            if t.get("track") != n:
+                raise ValueError(f"track numbering {t.get('track')} != {n}")
+            z = t["depth"]
+            if z is None or not math.isfinite(float(z)):
+                raise ValueError(f"track {n} depth {z!r}")
+            depths.append(float(z))
+            for k in ("J", "min_altitude", "iterations", "status", "safe"):
+                if k not in t:
+                    raise ValueError(f"track {n} has no {k!r}")
+        return depths, tr
+
+    def resim(self, depths):
+        """auvref's scalar simulation of the tool's depths, and the track
+        start states from the vectorized one."""
+        _, res = ar.evaluate_plan(self.vehicle, self.fm.prof, self.fm.X, depths)
+        Js, hs, states = self.fm.fly_plan([depths])
+        # the two f64 implementations (scalar auvref, vectorized Fast) agree
+        dj = max(abs(Js[0, i] - t["J"]) / max(abs(t["J"]), 1e-300)
+                 for i, t in enumerate(res["tracks"]))
+        dh = max(abs(hs[0, i] - t["min_altitude"]) for i, t in enumerate(res["tracks"]))
+        self.consistency.append((dj, dh))
+        return res, states
+
+    # ---- criterion 4 (every run) ----
+    def check_resim(self, key, out, depths, tracks, res):
+        h_a = self.h_a
+        bad = []
+        worst_j = worst_h = 0.0
+        n_safe = 0
+        lo, hi = self.fm.lo, self.fm.hi
+        for t, r, z in zip(tracks, res["tracks"], depths):
+            n = r["track"]
+            if not (lo - 1e-6 <= z <= hi + 1e-6):
+                bad.append(f"track {n} depth {z} outside [{lo}, {hi}]")
+            J = float(t["J"])
+            rel = abs(J - r["J"]) / max(abs(r["J"]), 1e-300)
+            worst_j = max(worst_j, rel)
+            if abs(J - r["J"]) > J_RESIM_RTOL * abs(r["J"]) + J_FLOOR:
+                bad.append(f"track {n} J {J:.9g} but re-simulated {r['J']:.9g} (rel {rel:.1e})")
+            worst_h = max(worst_h, abs(float(t["min_altitude"]) - r["min_altitude"]))
+            if t["safe"] is True:
+                n_safe += 1
+                if r["min_altitude"] < h_a - ALT_TOL:
+                    bad.append(f"track {n} reported safe, re-simulated min altitude "
+                               f"{r['min_altitude']:.4f} < h_a {h_a:g} - {ALT_TOL:g}")
+        if out.get("safe") is True and res["min_altitude"] < h_a - ALT_TOL:
+            bad.append(f"flight reported safe, re-simulated min altitude "
+                       f"{res['min_altitude']:.4f} < h_a")
+        msg = (f"{n_safe}/{len(tracks)} tracks reported safe, all confirmed; "
+               if not bad else "") + \
+            f"J vs re-sim max rel {worst_j:.1e}, min altitude max |diff| {worst_h:.1e} m"
+        if bad:
+            msg += "; " + "; ".join(bad)
+        self.add(not bad, f"C4 resim [{key}]", msg)
+
+    # ---- criteria 1 and 2 ----
+    def check_track_mode(self, key, constrained, tracks, res, states):
+        rows = []
+        for n in range(1, self.fm.M + 1):
+            t = tracks[n - 1]
+            r = self.search(states[n - 1], n)
+            J = float(t["J"])
+            it = int(t["iterations"])
+            st = t["status"]
+            hmin = res["tracks"][n - 1]["min_altitude"]
+            row = {"track": n, "tool_depth": float(t["depth"]), "tool_J": J,
+                   "tool_iterations": it, "tool_status": st, "tool_safe": t["safe"],
+                   "resim_J": res["tracks"][n - 1]["J"], "resim_min_altitude": hmin,
+                   "ref": r}
+            rows.append(row)
+            if not constrained:
+                best = r["best_J"]
+                ratio = J / best if best > 0 else float("inf")
+                ok = J <= J_RATIO_TRACK * best + J_FLOOR and it <= MAX_ITER_BFGS
+                note = ""
+                if J < best - (1e-4 * best + J_FLOOR):
+                    note = " (the tool beats the reference search)"
+                row["ratio"] = ratio
+                self.add(ok, f"C1 track {n} [{key}]",
+                         f"J {_g(J)} (z {t['depth']:.3f}) best {_g(best)} (z {r['best_z']:.3f}) "
+                         f"ratio {ratio:.5f}, iterations {it}, {st}{note}")
+                continue
+            if not r["feasible"]:
+                ok = st == "infeasible" or hmin >= self.h_a
+                note = (" (the tool's depth is safe: the reference search missed it)"
+                        if hmin >= self.h_a else "")
+                self.add(ok, f"C2 track {n} [{key}]",
+                         f"no safe depth in [{self.fm.lo:g}, {self.fm.hi:g}] (best min altitude "
+                         f"{r['max_min_altitude']:.3f} m at z {r['z_max_min_altitude']:.2f} < h_a "
+                         f"{self.h_a:g}); tool status {st}, depth {t['depth']:.3f}, "
+                         f"min altitude {hmin:.3f}{note}")
+                continue
+            best = r["best_safe_J"]
+            ratio = J / best if best > 0 else float("inf")
+            row["ratio"] = ratio
+            safe_ok = hmin >= self.h_a - ALT_TOL
+            ok = safe_ok and st != "infeasible" and J <= J_RATIO_TRACK * best + J_FLOOR
+            note = ""
+            if J < best - (1e-4 * best + J_FLOOR) and hmin >= self.h_a:
+                note = " (the tool beats the reference search)"
+            self.add(ok, f"C2 track {n} [{key}]",
+                     f"J {_g(J)} (z {t['depth']:.3f}, min alt {hmin:.3f}{'' if safe_ok else ' UNSAFE'}) "
+                     f"best safe {_g(best)} (z {r['best_safe_z']:.3f}) ratio {ratio:.5f}, "
+                     f"iterations {it}, {st}{note}")
+        return rows
+
+    # ---- criterion 3 ----
+    def check_horizon(self, key, out, tracks, res):
+        hz = self.horizon()
+        tot = float(out["total_J"])
+        safe_tool = res["min_altitude"] >= self.h_a - ALT_TOL
+        sts = [t["status"] for t in tracks]
+        info = {"tool_total_J": tot, "tool_depths": [float(t["depth"]) for t in tracks],
+                "tool_statuses": sts, "tool_safe": out.get("safe"),
+                "resim_min_altitudes": [t["min_altitude"] for t in res["tracks"]],
+                "reference": hz}
+        if hz["safe_plan"]:
+            best = hz["total_J"]
+            ratio = tot / best
+            info["ratio"] = ratio
+            ok = safe_tool and tot <= J_RATIO_HORIZON * best + J_FLOOR
+            note = ""
+            if tot < best - (1e-4 * best + J_FLOOR) and res["min_altitude"] >= self.h_a:
+                note = " (the tool beats the reference search)"
+            self.add(ok, f"C3 horizon [{key}]",
+                     f"total J {_g(tot)} best safe {_g(best)} ratio {ratio:.4f}; tool flight "
+                     f"min altitude {res['min_altitude']:.3f}{'' if safe_tool else ' UNSAFE'} "
+                     f"(h_a {self.h_a:g}); statuses {','.join(sts)}{note}")
+        else:
+            claims_safe = out.get("safe") is True
+            ok = (not claims_safe) or res["min_altitude"] >= self.h_a
+            note = ""
+            if res["min_altitude"] >= self.h_a:
+                note = " (the tool's flight is safe: the beam search missed it)"
+            self.add(ok, f"C3 horizon [{key}]",
+                     f"no safe plan found (every partial plan unsafe on track "
+                     f"{hz['dead_track']}, best min altitude there {hz['max_min_altitude']:.3f} "
+                     f"< h_a {self.h_a:g}); tool says safe={out.get('safe')}, statuses "
+                     f"{','.join(sts)}, total J {_g(tot)}, flight min altitude "
+                     f"{res['min_altitude']:.3f}{note}")
+        return info
+
+    # ---- one tool run ----
+    def check_run(self, key, out, err=""):
+        if out is None:
+            self.add(False, f"run [{key}]", err)
+            return None
+        try:
+            depths, tracks = self.parse(out)
+            float(out["total_J"])
+        except (KeyError, TypeError, ValueError) as e:
+            self.add(False, f"run [{key}]", f"malformed JSON output: {e!r}")
+            return None
+        res, states = self.resim(depths)
+        self.check_resim(key, out, depths, tracks, res)
+        d = {"depths": depths, "tool": out, "resim": res}
+        if key == "track_unconstrained_bfgs":
+            d["tracks"] = self.check_track_mode(key, False, tracks, res, states)
+        elif key == "track_constrained_bfgs":
+            d["tracks"] = self.check_track_mode(key, True, tracks, res, states)
+        elif key == "horizon_bfgs":
+            d["horizon"] = self.check_horizon(key, out, tracks, res)
+        self.data["runs"][key] = d
+        return d
+
+    def gd_info(self):
+        runs = self.data["runs"]
+        g, b = runs.get("track_unconstrained_gd"), runs.get("track_unconstrained_bfgs")
+        if not g or not b:
+            return
+        gi = [t["iterations"] for t in g["tool"]["tracks"]]
+        bi = [t["iterations"] for t in b["tool"]["tracks"]]
+        gs = [t["status"] for t in g["tool"]["tracks"]]
+        line = (f"info C5 gd vs bfgs {self.name}: iterations gd {gi} vs bfgs {bi}; "
+                f"gd statuses {','.join(gs)}; total J gd {_g(g['tool']['total_J'])} vs bfgs "
+                f"{_g(b['tool']['total_J'])}")
+        self.info.append(line)
+        self.data["gd_vs_bfgs"] = {"gd_iterations": gi, "bfgs_iterations": bi,
+                                   "gd_statuses": gs,
+                                   "gd_total_J": g["tool"]["total_J"],
+                                   "bfgs_total_J": b["tool"]["total_J"]}
+
+
+# --------------------------------------------------------------------------
+# Self-test: the checker fed plans from its own searches
+# --------------------------------------------------------------------------
+
+
+class SelfTool:
+    """Stands in for the Rust tool: track mode flies the searches' best
+    depths track by track (best safe, or the highest one where none is safe,
+    marked infeasible); horizon mode the beam search's plan."""
+
+    def __init__(self, cc: CaseChecker):
+        self.cc = cc
+        self.plans = {}
+
+    def track_plan(self, constrained):
+        cc, fm = self.cc, self.cc.fm
+        S = fm.start()
+        depths, sts = [], []
+        for n in range(1, fm.M + 1):
+            r = cc.search(S, n)
+            if not constrained:
+                z, st = r["best_z"], "converged"
+            elif r["feasible"]:
+                z, st = r["best_safe_z"], "converged"
+            else:
+                z, st = r["z_max_min_altitude"], "infeasible"
+            depths.append(z)
+            sts.append(st)
+            _, _, S = fm.fly(S, [z], n)
+        return depths, sts
+
+    def plan(self, key):
+        if key not in self.plans:
+            fm = self.cc.fm
+            if key.startswith("track"):
+                depths, sts = self.track_plan("_constrained" in key)
+            else:
+                hz = self.cc.horizon()
+                if hz["safe_plan"]:
+                    depths, sts = hz["plan"], ["converged"] * fm.M
+                else:
+                    depths, sts = self.track_plan(True)
+            self.plans[key] = (depths, sts)
+        return self.plans[key]
+
+    def __call__(self, case, key, mode, method, unconstrained):
+        depths, sts = self.plan(key)
+        its = [40 if method == "gd" else 3] * self.cc.fm.M
+        out = plan_json(self.cc.fm, depths, mode, method, sts, its)
+        return json.loads(json.dumps(out)), "", 0.0, "self-test " + " ".join(
+            tool_args(case, mode, method, unconstrained)[6:])
+
+
+def negative_tests(cc: CaseChecker, tool: SelfTool):
+    """Spoiled outputs that the checker must reject: [(what, detected)]."""
+    fm, h_a, M = cc.fm, cc.h_a, cc.fm.M
+    out = []
+
+    def trial(key, doc, expect):
+        saved = (cc.checks, cc.data, cc.consistency)
+        cc.checks, cc.data, cc.consistency = [], {"runs": {}}, []
+        try:
+            cc.check_run(key, json.loads(json.dumps(doc)))
+            got = cc.checks
+        finally:
+            cc.checks, cc.data, cc.consistency = saved
+        fails = [line for ok, line in got if not ok]
+        detected = all(any(e in line for line in fails) for e in expect)
+        out.append((f"{key}: {what}", detected, fails))
+
+    # N1: unconstrained, last track's depth moved off the optimum (honest J)
+    key = "track_unconstrained_bfgs"
+    depths, sts = tool.plan(key)
+    _, _, states = fm.fly_plan([depths])
+    r = cc.search(states[M - 1], M)
+    for k in (2, 5, 10, 20, 50, 100, 300):
+        z = float(np.clip(depths[-1] + k * zscale(fm), fm.lo, fm.hi))
+        J, _, _ = fm.fly(states[M - 1], [z], M)
+        if J[0] > 1.02 * r["best_J"] + 1.0:
+            what = f"track {M} depth {depths[-1]:.2f} -> {z:.2f} (J x{J[0] / r['best_J']:.3f})"
+            trial(key, plan_json(fm, depths[:-1] + [z], "track", "bfgs", sts, [3] * M),
+                  [f"C1 track {M} "])
+            break
+    # N2: 11 iterations on track 1
+    what = "11 iterations on track 1"
+    trial(key, plan_json(fm, depths, "track", "bfgs", sts, [11] + [3] * (M - 1)), ["C1 track 1 "])
+    # N6: a reported J that is not the flight's
+    doc = plan_json(fm, depths, "track", "bfgs", sts, [3] * M)
+    doc["tracks"][0]["J"] *= 0.9
+    what = "track 1 J reported x0.9"
+    trial(key, doc, ["C4 resim"])
+
+    key = "track_constrained_bfgs"
+    depths, sts = tool.plan(key)
+    _, _, states = fm.fly_plan([depths])
+    for k in (M, M - 1):
+        r = cc.search(states[k - 1], k)
+        if r["feasible"] and r["best_min_altitude"] < h_a - 0.05:
+            # N3: the unconstrained optimum, unsafe, claimed safe
+            dz = list(depths)
+            dz[k - 1] = r["best_z"]
+            doc = plan_json(fm, dz, "track", "bfgs", sts, [3] * M)
+            doc["tracks"][k - 1]["safe"] = True
+            what = (f"track {k} unsafe depth {r['best_z']:.2f} (min alt "
+                    f"{r['best_min_altitude']:.2f}) claimed safe")
+            trial(key, doc, [f"C2 track {k} ", "C4 resim"])
+            break
+    for k in range(M, 0, -1):
+        if sts[k - 1] != "infeasible":
+            # N4: a feasible track said infeasible
+            s2 = list(sts)
+            s2[k - 1] = "infeasible"
+            what = f"feasible track {k} reported infeasible"
+            trial(key, plan_json(fm, depths, "track", "bfgs", s2, [3] * M), [f"C2 track {k} "])
+            break
+    for k in range(1, M + 1):
+        if sts[k - 1] == "infeasible":
+            # N7: an infeasible track claimed converged and safe
+            s2 = list(sts)
+            s2[k - 1] = "converged"
+            doc = plan_json(fm, depths, "track", "bfgs", s2, [3] * M)
+            doc["tracks"][k - 1]["safe"] = True
+            doc["safe"] = True
+            what = f"infeasible track {k} claimed converged and safe"
+            trial(key, doc, [f"C2 track {k} ", "C4 resim"])
+            break
+
+    key = "horizon_bfgs"
+    hz = cc.horizon()
+    if hz["safe_plan"]:
+        plan = list(hz["plan"])
+        Jbest = hz["total_J"]
+        _, _, states = fm.fly_plan([plan])
+        # N5: a safe but poor last depth (total J > 1.15 x best)
+        cand = np.linspace(fm.lo, min(fm.hi, plan[-1] + 300.0), 61)
+        J, h, _ = fm.fly(np.repeat(states[M - 1], len(cand), axis=1), cand, M)
+        tot = Jbest - hz["J"][-1] + J
+        ok = np.nonzero((h >= h_a + 0.05) & (tot > 1.15 * Jbest))[0]
+        if len(ok):
+            i = ok[int(np.argmin(tot[ok]))]
+            what = f"safe last depth {cand[i]:.2f}, total J x{tot[i] / Jbest:.3f}"
+            trial(key, plan_json(fm, plan[:-1] + [float(cand[i])], "horizon", "bfgs"),
+                  ["C3 horizon"])
+        # N8: the unconstrained track plan, unsafe, as the horizon plan
+        du, su = tool.plan("track_unconstrained_bfgs")
+        _, res = ar.evaluate_plan(fm.v, fm.prof, fm.X, du)
+        if res["min_altitude"] < h_a - 0.05:
+            what = f"unsafe plan (min alt {res['min_altitude']:.2f})"
+            trial(key, plan_json(fm, du, "horizon", "bfgs"), ["C3 horizon"])
+    return out
+
+
+# --------------------------------------------------------------------------
+# Driver
+# --------------------------------------------------------------------------
+
+
+def run_case(job):
+    case, o = job
+    t0 = time.time()
+    cc = CaseChecker(case, beam=o["beam"], nz=o["nz"], seed=o["seed"])
+    tool = SelfTool(cc) if o["self_test"] else ToolRunner(o["bin_cmd"], o["cwd"], o["timeout"])
+    meta = {}
+    tool_time = 0.0
+    for key, mode, method, unc in RUNS:
+        out, err, dt, cmdline = tool(case, key, mode, method, unc)
+        tool_time += dt
+        meta[key] = {"seconds": dt, "command": cmdline, "error": err}
+        cc.check_run(key, out, err)
+    cc.gd_info()
+    cc.data["tool_runs"] = meta
+    dj = max((c[0] for c in cc.consistency), default=0.0)
+    dh = max((c[1] for c in cc.consistency), default=0.0)
+    cc.data["auvref_vs_vectorized"] = {"max_rel_J": dj, "max_abs_min_altitude": dh}
+    if o["self_test"]:
+        cc.add(dj <= 1e-9 and dh <= 1e-9, "self-test simulators",
+               f"auvref vs vectorized: max rel J {dj:.1e}, max |min alt| {dh:.1e} m")
+        for what, detected, fails in negative_tests(cc, tool):
+            cc.add(detected, "self-test negative",
+                   f"{what}: {'caught' if detected else 'NOT caught'}"
+                   + (f" ({fails[0].split(': ', 1)[-1][:110]})" if fails else ""))
+    elif dj > 1e-9 or dh > 1e-9:
+        cc.info.append(f"WARN reference {cc.name}: auvref vs vectorized differ "
+                       f"(rel J {dj:.1e}, min alt {dh:.1e} m)")
+    cc.data["seconds"] = time.time() - t0
+    cc.data["tool_seconds"] = tool_time
+    hdr = (f"== {cc.name}: h_r {cc.vehicle.reference_altitude:g} h_a {cc.h_a:g}, "
+           f"{cc.fm.M} tracks, {time.time() - t0:.1f} s (tool {tool_time:.1f} s)")
+    return hdr, cc.checks, cc.info, cc.data
+
+
+def _jsonable(o):
+    if isinstance(o, (np.floating,)):
+        return float(o)
+    if isinstance(o, (np.integer,)):
+        return int(o)
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    if isinstance(o, (np.bool_,)):
+        return bool(o)
+    raise TypeError(type(o))
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                 formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__)
+    ap.add_argument("--bin-cmd", default=DEFAULT_CMD,
+                    help=f"command the arguments are appended to (default: {DEFAULT_CMD!r})")
+    ap.add_argument("--cwd", default=ROOT, help="working directory of the tool")
+    ap.add_argument("--self-test", action="store_true",
+                    help="no tool: feed the checker its own plans (and spoiled ones)")
+    ap.add_argument("--unseen", type=int, default=3, help="random profiles (default 3)")
+    ap.add_argument("--seed", type=int, default=7, help="seed of the random profiles")
+    ap.add_argument("--only", nargs="+", metavar="NAME",
+                    help="only the cases whose name contains one of these")
+    ap.add_argument("--no-shared", action="store_true", help="skip the six real profiles")
+    ap.add_argument("--beam", type=int, default=100, help="beam width B (default 100)")
+    ap.add_argument("--nz", type=int, default=32, help="depths per beam state (default 32)")
+    ap.add_argument("--jobs", type=int, default=2, help="profiles checked in parallel")
+    ap.add_argument("--timeout", type=float, default=600.0, help="seconds per tool run")
+    ap.add_argument("--json-out", metavar="FILE", help="write every number to FILE")
+    ap.add_argument("--keep", metavar="DIR", help="keep the generated inputs in DIR")
+    a = ap.parse_args(argv)
+
+    cases = [] if a.no_shared else [{"name": n, "h_r": hr, "h_a": ha} for n, hr, ha in SHARED]
+    cases += [unseen_case(a.seed, i) for i in range(a.unseen)]
+    if a.only:
+        cases = [c for c in cases if any(s in c["name"] for s in a.only)]
+    base = a.keep or tempfile.mkdtemp(prefix="check_planner_")
+    os.makedirs(base, exist_ok=True)
+    for c in cases:
+        write_case(c, base)
+    o = {"beam": a.beam, "nz": a.nz, "seed": a.seed, "self_test": a.self_test,
+         "bin_cmd": a.bin_cmd, "cwd": a.cwd, "timeout": a.timeout}
+    t0 = time.time()
+    passed = failed = 0
+    report = {"generator": "tools/reference/check_planner.py", "argv": sys.argv[1:],
+              "self_test": a.self_test, "bin_cmd": None if a.self_test else a.bin_cmd,
+              "thresholds": {"J_ratio_track": J_RATIO_TRACK, "J_floor": J_FLOOR,
+                             "max_iterations_bfgs": MAX_ITER_BFGS,
+                             "J_ratio_horizon": J_RATIO_HORIZON, "alt_tol": ALT_TOL,
+                             "J_resim_rtol": J_RESIM_RTOL},
+              "cases": []}
+    jobs = [(c, o) for c in cases]
+    try:
+        if a.jobs > 1 and len(jobs) > 1:
+            pool = multiprocessing.get_context("fork").Pool(min(a.jobs, len(jobs)))
+            results = pool.imap(run_case, jobs)
+        else:
+            pool = None
+            results = map(run_case, jobs)
+        for hdr, checks, info, data in results:
+            print(hdr)
+            for ok, line in checks:
+                print(line)
+                passed += ok
+                failed += not ok
+            for line in info:
+                print(line)
+            sys.stdout.flush()
+            report["cases"].append(data)
+        if pool is not None:
+            pool.close()
+            pool.join()
+    finally:
+        if not a.keep:
+            shutil.rmtree(base, ignore_errors=True)
+    report["seconds"] = time.time() - t0
+    report["passed"], report["failed"] = passed, failed
+    if a.json_out:
+        with open(a.json_out, "w") as f:
+            json.dump(report, f, indent=1, default=_jsonable)
+    print(f"total time {time.time() - t0:.1f} s")
+    print(f"{passed} passed, {failed} failed")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
