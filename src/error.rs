@@ -66,6 +66,8 @@ pub enum Error {
     Config(ConfigError),
     /// A simulation could not be run or did not finish.
     Sim(SimError),
+    /// The planner could not plan.
+    Plan(crate::planner::PlanError),
 }
 
 impl fmt::Display for Error {
@@ -75,6 +77,7 @@ impl fmt::Display for Error {
             Self::Plant(e) => e.fmt(f),
             Self::Config(e) => e.fmt(f),
             Self::Sim(e) => e.fmt(f),
+            Self::Plan(e) => e.fmt(f),
         }
     }
 }
@@ -99,6 +102,11 @@ impl From<ConfigError> for Error {
 impl From<crate::sim::WaypointError> for Error {
     fn from(e: crate::sim::WaypointError) -> Self {
         Self::Sim(SimError::Waypoints(e))
+    }
+}
+impl From<crate::planner::PlanError> for Error {
+    fn from(e: crate::planner::PlanError) -> Self {
+        Self::Plan(e)
     }
 }
 impl From<SimError> for Error {

@@ -30,6 +30,12 @@
 //! 6. [`gradient`] — the same pass with tangent states gives the exact
 //!    gradient of `J` and of the violation with respect to the next `K`
 //!    reference depths ([`Evaluation`]).
+//! 7. [`optim`] — allocation-free gradient descent and dense BFGS with an
+//!    Armijo line search, on a box.
+//! 8. [`planner`] — the main entry point: a [`Planner`] takes the vehicle
+//!    state at the start of the next track and returns that track's
+//!    reference depth ([`Plan`]), verified safe by simulation or flagged
+//!    [`PlanStatus::SafeFallback`] / [`PlanStatus::Infeasible`].
 //!
 //! Shapes are const generics: `N` the plant order capacity, `S` the profile
 //! capacity, `W` the waypoint capacity, `K` the number of depths optimized

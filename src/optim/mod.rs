@@ -8,8 +8,8 @@
 //! at the starting point is an error.
 //!
 //! Every numerical safeguard is named and documented where it acts:
-//! the curvature guard and the first-step scaling in [`bfgs`], the
-//! backtracking cap in [`armijo`], the step cap in [`BfgsConfig`].
+//! the curvature guard and the first-step scaling in [`mod@bfgs`], the
+//! backtracking cap in [`mod@armijo`], the step cap in [`BfgsConfig`].
 
 pub mod armijo;
 pub mod bfgs;
