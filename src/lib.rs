@@ -67,6 +67,7 @@ pub mod autopilot;
 pub mod error;
 pub mod expm;
 pub mod gradient;
+mod log;
 mod num;
 pub mod optim;
 pub mod planner;

@@ -470,6 +470,16 @@ impl<const K: usize> Planner<K> {
             };
         }
         let safe = score.min_altitude() >= h_safe;
+        crate::log::debug!(
+            "plan track {=usize}: depth {=f32} m, {=str}, J {=f32} m3, min altitude {=f32} m, {=u32} iterations, {=u32} evaluations",
+            track,
+            depth,
+            status.as_str(),
+            score.j(),
+            score.min_altitude(),
+            iterations,
+            evaluations
+        );
 
         // Keep the rest of the horizon for the next call.
         let mut horizon = [0.0_f32; K];

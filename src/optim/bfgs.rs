@@ -185,6 +185,14 @@ pub fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         g = t.g;
         iterations = iterations.saturating_add(1);
         let _ = history.push(j);
+        crate::log::debug!(
+            "bfgs iteration {=u32}: J {=f32} m3, |G| {=f32} m2, step {=f32} m, evaluations {=u32}",
+            iterations,
+            j,
+            g.norm(),
+            dz.norm(),
+            evaluations
+        );
         // Stopping rule 3.14b.
         if libm::fabsf(dj) <= cfg.tol.j_threshold(j) {
             break Status::Converged;

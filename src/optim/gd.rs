@@ -80,6 +80,12 @@ pub fn gradient_descent<const K: usize, O: Objective<K>>(
         g = gt;
         iterations = iterations.saturating_add(1);
         let _ = history.push(j);
+        crate::log::debug!(
+            "gd iteration {=u32}: J {=f32} m3, |G| {=f32} m2",
+            iterations,
+            j,
+            g.norm()
+        );
         if libm::fabsf(dj) <= cfg.tol.j_threshold(j) {
             break Status::Converged;
         }
