@@ -85,6 +85,8 @@ impl Default for AutopilotConfig {
 pub struct Autopilot {
     cfg: AutopilotConfig,
     sign: f32,
+    /// The pitch gains times the loop sign, folded once.
+    signed_pitch: PidGains,
     sample_time: f32,
 }
 
@@ -167,9 +169,16 @@ impl Autopilot {
         }
         positive(cfg.elevator_limit, "elevator_limit")?;
         positive(sample_time, "sample_time")?;
+        let sign = tf.loop_sign();
+        let g = cfg.pitch_pid;
         Ok(Self {
             cfg: *cfg,
-            sign: tf.loop_sign(),
+            sign,
+            signed_pitch: PidGains {
+                kp: sign * g.kp,
+                ki: sign * g.ki,
+                kd: sign * g.kd,
+            },
             sample_time,
         })
     }
@@ -234,11 +243,11 @@ impl Autopilot {
         let (pitch_ref, pitch_ref_linear) = clamp_sym(v, self.cfg.pitch_limit);
 
         let e_t = pitch_ref - pitch;
-        let g = &self.cfg.pitch_pid;
+        let g = &self.signed_pitch;
         let pitch_terms = PidTerms {
-            p: self.sign * g.kp * e_t,
-            i: self.sign * g.ki * *pitch_integral,
-            d: -self.sign * g.kd * pitch_rate,
+            p: g.kp * e_t,
+            i: g.ki * *pitch_integral,
+            d: -g.kd * pitch_rate,
         };
         let w = pitch_terms.p + pitch_terms.i + pitch_terms.d;
         let (elevator, elevator_linear) = clamp_sym(w, self.cfg.elevator_limit);

@@ -184,25 +184,34 @@ impl<const S: usize> Profile<S> {
     /// The cursor makes the lookups of a simulation, whose `x` moves by a
     /// fraction of a sample spacing per step, O(1) instead of a search.
     /// Returns `None` outside the profile.
+    #[inline]
     pub(crate) fn locate(&self, cursor: &mut Cursor, x: Comp) -> Option<Point> {
-        let last = self.x.len().checked_sub(2)?;
-        if !cursor.valid || cursor.seg > last {
-            cursor.seg = self.search(x.value())?;
-            self.load(cursor)?;
-        }
-        while cursor.seg < last && x.minus(cursor.x1) >= 0.0 {
-            cursor.seg = cursor.seg.saturating_add(1);
-            self.load(cursor)?;
-        }
-        while cursor.seg > 0 && x.minus(cursor.x0) < 0.0 {
-            cursor.seg = cursor.seg.saturating_sub(1);
+        let xv = x.value();
+        // Fast path: still in the cached segment (plain f32 compares; the
+        // choice of segment only matters away from the shared end points,
+        // where both neighbours interpolate to the same depth).
+        if !(cursor.valid && xv >= cursor.x0 && xv < cursor.x1) {
+            // Outside the profile (or NaN): fail, never extrapolate. The
+            // range test is on the compensated position, exact at the ends.
+            let (&first, &last) = (self.x.first()?, self.x.last()?);
+            if !(x.minus(first) >= 0.0 && x.minus(last) <= 0.0) {
+                return None;
+            }
+            let next = cursor.seg.saturating_add(1);
+            cursor.seg = if cursor.valid
+                && xv >= cursor.x1
+                && self
+                    .x
+                    .get(next.saturating_add(1))
+                    .is_some_and(|&x2| xv < x2)
+            {
+                next
+            } else {
+                self.search(xv)?
+            };
             self.load(cursor)?;
         }
         let offset = x.minus(cursor.x0);
-        // Outside the profile (or NaN): fail, never extrapolate.
-        if !(offset >= 0.0 && x.minus(cursor.x1) <= 0.0) {
-            return None;
-        }
         Some(Point {
             depth: cursor.b0 + cursor.slope * offset,
             base: cursor.b0,

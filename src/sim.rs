@@ -456,7 +456,20 @@ impl<const N: usize> Sensitivity<N> for NoSensitivity {
 struct Geo {
     x: Comp,
     d: Comp,
-    bottom: Option<Point>,
+    /// Where the sample is scored (`x <= x_end`): what scoring needs of it.
+    at: Option<At>,
+    /// `x − x_end`, m: the run ends at the first sample with `past >= 0`.
+    past: f32,
+}
+
+/// A scored sample: altitude `h`, bottom slope `b'`, `e = h − h_r` and
+/// `p = max(0, h_p − h)` (m, m/m, m, m), computed once per sample.
+#[derive(Clone, Copy, Debug)]
+struct At {
+    h: f32,
+    slope: f32,
+    e: f32,
+    p: f32,
 }
 
 /// A vehicle flying a line of waypoints over a bottom profile, with the
@@ -639,20 +652,24 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                 Geo {
                     x: st.x_prev,
                     d: st.depth_prev,
-                    bottom: None,
+                    at: None,
+                    past: st.x_prev.minus(x_end),
                 }
             };
             self.score(&prev, &cur, first, first, last, scores, sens)?;
-        } else if let (Some(p), Some(s)) = (cur.bottom, scores.first_mut()) {
-            s.min_altitude = s.min_altitude.min(p.altitude(cur.d));
+        } else if let (Some(a), Some(s)) = (cur.at, scores.first_mut()) {
+            s.min_altitude = s.min_altitude.min(a.h);
         }
 
         let mut track = first;
+        // X_{track+1}: where the active track ends.
+        let mut track_end = x_next;
         let mut steps = 0_u32;
+        // θ_k: computed once per step, as θ_{k+1} of the step before.
+        let mut pitch = plant.pitch(&st.eta);
         loop {
-            let pitch = plant.pitch(&st.eta);
             let pitch_rate = plant.pitch_rate(&st.eta);
-            if st.x.minus(x_end) >= 0.0 {
+            if cur.past >= 0.0 {
                 observe(&Sample {
                     x: st.x(),
                     depth: st.depth(),
@@ -663,12 +680,11 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                 });
                 break;
             }
-            while track.saturating_add(1) < last
-                && wp
-                    .get(track.saturating_add(1))
-                    .is_some_and(|&xw| st.x.minus(xw) >= 0.0)
-            {
+            while track.saturating_add(1) < last && st.x.minus(track_end) >= 0.0 {
                 track = track.saturating_add(1);
+                track_end = *wp
+                    .get(track.saturating_add(1))
+                    .ok_or(SimError::TrackRange)?;
             }
             let slot = track.saturating_sub(first);
             let r = *depths.get(slot).ok_or(SimError::TrackRange)?;
@@ -698,7 +714,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
             let eta = plant.step(&st.eta, command.elevator);
             let pitch_next = plant.pitch(&eta);
             let mean = 0.5 * (pitch + pitch_next) * DEG;
-            let (sin, cos) = (libm::sinf(mean), libm::cosf(mean));
+            let (sin, cos) = crate::num::sin_cos(mean);
             let dx = step_len * cos;
             let dd = -step_len * sin;
             // NaN fails `dx > 0` too.
@@ -706,6 +722,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                 return Err(SimError::Diverged);
             }
             st.eta = eta;
+            pitch = pitch_next;
             st.depth_prev = st.depth;
             st.x_prev = st.x;
             st.depth = st.depth.add(dd);
@@ -721,7 +738,38 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
             );
             let prev = cur;
             cur = self.geo(&mut cursor, st.x, st.depth, x_end)?;
-            self.score(&prev, &cur, track, first, last, scores, sens)?;
+            match (prev.at, cur.at) {
+                // The common case: a segment inside the active track, both
+                // samples scored already; Δx and Δd are the step's exact
+                // increments.
+                (Some(a0), Some(a1)) if st.x.minus(track_end) <= 0.0 => {
+                    let s = scores.get_mut(slot).ok_or(SimError::ScoreBuffer)?;
+                    s.j.add(0.25 * dx * (a0.e * a0.e + a1.e * a1.e));
+                    if a0.p > 0.0 || a1.p > 0.0 {
+                        s.violation.add(0.25 * dx * (a0.p * a0.p + a1.p * a1.p));
+                    }
+                    s.min_altitude = s.min_altitude.min(a0.h).min(a1.h);
+                    sens.piece(
+                        slot,
+                        &PieceLin {
+                            len: dx,
+                            dx,
+                            dd,
+                            lo: End {
+                                at: EndAt::Start { slope: a0.slope },
+                                e: a0.e,
+                                p: a0.p,
+                            },
+                            hi: End {
+                                at: EndAt::End { slope: a1.slope },
+                                e: a1.e,
+                                p: a1.p,
+                            },
+                        },
+                    );
+                }
+                _ => self.score(&prev, &cur, track, first, last, scores, sens)?,
+            }
         }
         if scores.iter().any(|s| !s.min_altitude.is_finite()) {
             return Err(SimError::Diverged);
@@ -734,16 +782,24 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     /// profile.
     #[inline]
     fn geo(&self, cursor: &mut Cursor, x: Comp, d: Comp, x_end: f32) -> Result<Geo, SimError> {
-        let bottom = if x.minus(x_end) <= 0.0 {
-            Some(
-                self.profile
-                    .locate(cursor, x)
-                    .ok_or(SimError::OutOfProfile)?,
-            )
+        let past = x.minus(x_end);
+        let at = if past <= 0.0 {
+            let p: Point = self
+                .profile
+                .locate(cursor, x)
+                .ok_or(SimError::OutOfProfile)?;
+            let h = p.altitude(d);
+            let End { e, p: pen, .. } = self.end(EndAt::Clip { t: 0.0 }, h);
+            Some(At {
+                h,
+                slope: p.slope,
+                e,
+                p: pen,
+            })
         } else {
             None
         };
-        Ok(Geo { x, d, bottom })
+        Ok(Geo { x, d, at, past })
     }
 
     /// Scores segment `s0 → s1`, flown from track `track`, into every track
@@ -795,7 +851,10 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                 let (lo, h_lo) = lo;
                 let (hi, h_hi) = hi;
                 s.j.add(0.25 * len * (lo.e * lo.e + hi.e * hi.e));
-                s.violation.add(0.25 * len * (lo.p * lo.p + hi.p * hi.p));
+                // Most pieces keep clear of the penalty altitude.
+                if lo.p > 0.0 || hi.p > 0.0 {
+                    s.violation.add(0.25 * len * (lo.p * lo.p + hi.p * hi.p));
+                }
                 s.min_altitude = s.min_altitude.min(h_lo).min(h_hi);
                 sens.piece(
                     slot,
@@ -819,14 +878,13 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     /// A piece end at one of the segment's samples, with its altitude.
     #[inline]
     fn sample_end(&self, s: &Geo, first: bool) -> Result<(End, f32), SimError> {
-        let p = s.bottom.ok_or(SimError::OutOfProfile)?;
-        let h = p.altitude(s.d);
+        let a = s.at.ok_or(SimError::OutOfProfile)?;
         let at = if first {
-            EndAt::Start { slope: p.slope }
+            EndAt::Start { slope: a.slope }
         } else {
-            EndAt::End { slope: p.slope }
+            EndAt::End { slope: a.slope }
         };
-        Ok((self.end(at, h), h))
+        Ok((End { at, e: a.e, p: a.p }, a.h))
     }
 
     /// A piece end clipped at waypoint `i`, depth interpolated in `x`.
