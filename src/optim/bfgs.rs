@@ -115,7 +115,26 @@ pub fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     cfg: &BfgsConfig,
     line_search: &L,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
+    bfgs_from(obj, z0, bounds, cfg, line_search, &SVector::zeros())
+}
+
+/// [`bfgs_with`] from a known diagonal curvature: `A_0 = diag(curvature)`
+/// where an entry is positive (m³/m², e.g. from a parabola through scanned
+/// values), the first-step scaling elsewhere. An informed metric is not
+/// rescaled before the first update.
+///
+/// # Errors
+/// As [`bfgs`].
+pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
+    obj: &mut O,
+    z0: &SVector<f32, K>,
+    bounds: &Bounds<K>,
+    cfg: &BfgsConfig,
+    line_search: &L,
+    curvature: &SVector<f32, K>,
+) -> Result<Outcome<K>, OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
+    let informed = curvature.iter().any(|&c| c.is_finite() && c > 0.0);
     if !bounds.is_valid() {
         return Err(OptimError::Config("bounds"));
     }
@@ -125,7 +144,7 @@ pub fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut history = heapless::Vec::<f32, HISTORY>::new();
     let _ = history.push(j);
     let mut metric: Option<SMatrix<f32, K, K>> = None;
-    let mut rescaled = false;
+    let mut rescaled = informed;
     let mut skipped_updates = 0_u32;
     let mut iterations = 0_u32;
 
@@ -139,7 +158,11 @@ pub fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             break Status::MaxIterations;
         }
         let identity = SMatrix::<f32, K, K>::identity() * (grad_norm / cfg.first_step);
-        let a = metric.get_or_insert(identity);
+        let scaled = grad_norm / cfg.first_step;
+        let initial = SMatrix::<f32, K, K>::from_diagonal(
+            &curvature.map(|c| if c.is_finite() && c > 0.0 { c } else { scaled }),
+        );
+        let a = metric.get_or_insert(initial);
         let dir = match direction(a, bounds, &z, &g) {
             Some(d) => d,
             None => {

@@ -21,7 +21,7 @@ use heapless::Vec;
 use nalgebra::SVector;
 
 pub use armijo::{Armijo, LineSearch, Trial};
-pub use bfgs::{BfgsConfig, bfgs};
+pub use bfgs::{BfgsConfig, bfgs, bfgs_from};
 pub use gd::{GdConfig, gradient_descent};
 
 /// A function to minimize: its value and gradient at a point.
