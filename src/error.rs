@@ -26,6 +26,10 @@ pub enum ConfigError {
     MinAltitudeAboveReference,
     /// `depth_limits` has its minimum above its maximum.
     DepthLimitsReversed,
+    /// The gains make the closed loop (plant, cascade, kinematics,
+    /// linearized about level flight) unstable: a depth or pitch
+    /// disturbance grows instead of dying out.
+    UnstableLoop,
     /// The plant was rejected.
     Plant(PlantError),
 }
@@ -41,6 +45,9 @@ impl fmt::Display for ConfigError {
                 f.write_str("min_altitude must not exceed reference_altitude")
             }
             Self::DepthLimitsReversed => f.write_str("depth_limits minimum exceeds maximum"),
+            Self::UnstableLoop => f.write_str(
+                "the gains make the closed loop unstable (a disturbance grows instead of dying out)",
+            ),
             Self::Plant(e) => write!(f, "plant: {e}"),
         }
     }

@@ -6,6 +6,14 @@ use crate::autopilot::{Autopilot, AutopilotConfig};
 use crate::error::{ConfigError, finite, positive};
 use crate::plant::{Plant, TransferFunction};
 
+/// Power-iteration steps of the stability check, and the window over which
+/// the growth is measured.
+const GROWTH_STEPS: u32 = 4096;
+const GROWTH_WINDOW: u32 = 1024;
+/// A disturbance growing more than this over the window means instability
+/// (a dominant eigenvalue above about 1 + 1e-4 per step).
+const UNSTABLE_GROWTH: f32 = 1.1;
+
 /// Everything about the vehicle that the user configures, with units.
 /// `Default` gives the paper's vehicle (model contract §9).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -59,11 +67,68 @@ impl<const N: usize> Vehicle<N> {
         positive(cfg.sample_time, "sample_time")?;
         let autopilot = Autopilot::new(&cfg.autopilot, &tf, cfg.sample_time)?;
         let plant = Plant::new(tf, cfg.sample_time)?;
-        Ok(Self {
+        let v = Self {
             speed: cfg.speed,
             plant,
             autopilot,
-        })
+        };
+        if v.disturbance_growth() > UNSTABLE_GROWTH {
+            return Err(ConfigError::UnstableLoop);
+        }
+        Ok(v)
+    }
+
+    /// How much a disturbance of the closed loop, linearized about level
+    /// flight on depth (no clamp active, `sin θ ≈ θ`), grows over the last
+    /// `GROWTH_WINDOW` of `GROWTH_STEPS` steps: the dominant eigenvalue of
+    /// the loop raised to that power, by power iteration on the step map
+    /// itself (no matrix is formed). Below 1 the loop is stable; a marginal
+    /// mode (an unused integrator, a loop without depth feedback) gives 1.
+    fn disturbance_growth(&self) -> f32 {
+        let ap = self.autopilot.config();
+        let (gd, ts) = (ap.depth_pid, self.sample_time());
+        let sign = self.autopilot.loop_sign();
+        let gp = ap.pitch_pid;
+        let step = self.speed * ts * crate::num::DEG;
+        // State: η, d, d_prev, I_d, I_θ; a disturbance in every component.
+        let mut eta = nalgebra::SVector::<f32, N>::repeat(0.1);
+        let (mut d, mut dp, mut id, mut it) = (1.0_f32, 0.5_f32, 0.1_f32, 0.1_f32);
+        let mut window = 0.0_f32;
+        for k in 0..GROWTH_STEPS {
+            let theta = self.plant.pitch(&eta);
+            let q = self.plant.pitch_rate(&eta);
+            let e_d = -d;
+            let v = -(gd.kp * e_d + gd.ki * id - gd.kd * (d - dp) / ts);
+            let e_t = v - theta;
+            let w = sign * (gp.kp * e_t + gp.ki * it - gp.kd * q);
+            // An integrator whose gain is zero feeds nothing back: leave it
+            // out, or its harmless linear drift would read as growth.
+            if gd.ki != 0.0 {
+                id += ts * e_d;
+            }
+            if gp.ki != 0.0 {
+                it += ts * e_t;
+            }
+            eta = self.plant.step(&eta, w);
+            let theta_next = self.plant.pitch(&eta);
+            dp = d;
+            d -= step * 0.5 * (theta + theta_next);
+            // Renormalize; accumulate the log growth over the last window.
+            let norm = libm::sqrtf(eta.norm_squared() + d * d + dp * dp + id * id + it * it);
+            if !(norm.is_finite() && norm > 0.0) {
+                return if norm == 0.0 { 0.0 } else { f32::INFINITY };
+            }
+            if k >= GROWTH_STEPS - GROWTH_WINDOW {
+                window += libm::logf(norm);
+            }
+            let inv = 1.0 / norm;
+            eta *= inv;
+            d *= inv;
+            dp *= inv;
+            id *= inv;
+            it *= inv;
+        }
+        libm::expf(window.min(80.0))
     }
 
     /// `U0`, m/s.
@@ -195,5 +260,41 @@ mod tests {
             Err(ConfigError::NotPositive("sample_time"))
         );
         assert!(Vehicle::c_auv4().is_ok());
+    }
+
+    #[test]
+    fn diverging_gains_are_rejected() {
+        let unstable = |f: fn(&mut VehicleConfig)| {
+            let mut cfg = VehicleConfig::default();
+            f(&mut cfg);
+            Vehicle::new(&cfg, TransferFunction::C_AUV4)
+        };
+        // No pitch damping and a stiff pitch loop: the pitch oscillation grows.
+        assert_eq!(
+            unstable(|c| {
+                c.autopilot.pitch_pid.kd = 0.0;
+                c.autopilot.pitch_pid.kp = 30.0;
+            }),
+            Err(ConfigError::UnstableLoop)
+        );
+        // A depth loop far too stiff for the pitch loop inside it.
+        assert_eq!(
+            unstable(|c| {
+                c.autopilot.depth_pid.kp = 60.0;
+                c.autopilot.depth_pid.kd = 0.0;
+            }),
+            Err(ConfigError::UnstableLoop)
+        );
+        // The default, a slow integral, and no depth feedback at all are fine.
+        assert!(unstable(|_| {}).is_ok());
+        assert!(unstable(|c| c.autopilot.depth_pid.ki = 0.02).is_ok());
+        assert!(
+            unstable(|c| c.autopilot.depth_pid = crate::PidGains {
+                kp: 0.0,
+                ki: 0.0,
+                kd: 0.0
+            })
+            .is_ok()
+        );
     }
 }

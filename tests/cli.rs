@@ -229,6 +229,8 @@ fn config_errors() {
             "order",
         ),
         ("[optimizer]\nmax_iterations = 0\n", "max_iterations"),
+        ("[pitch_pid]\nkp = 30.0\nkd = 0.0\n", "unstable"),
+        ("[plant]\nden = [1.0, 1e13, 1e13, 1e13]\n", "discretized"),
         ("speed = 1.5\n[[", "v.toml:2"),
     ];
     for (text, mention) in cases {
