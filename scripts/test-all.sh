@@ -15,6 +15,9 @@ say "host: cargo test (unit, golden fixtures, tool interface, doctests)"
 cargo test --all-targets
 cargo test --doc
 
+say "host: property tests, 10,000 random terrains (release)"
+cargo test --release --test properties -- --nocapture
+
 say "target: the library builds for Cortex-M4F (thumbv7em-none-eabihf), with and without defmt"
 cargo build --lib --release --target thumbv7em-none-eabihf
 cargo build --lib --release --target thumbv7em-none-eabihf --features defmt
