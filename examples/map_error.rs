@@ -17,7 +17,11 @@
     clippy::indexing_slicing,
     clippy::panic
 )]
-#![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss, clippy::float_cmp)]
+#![allow(
+    clippy::arithmetic_side_effects,
+    clippy::cast_precision_loss,
+    clippy::float_cmp
+)]
 
 use auvnav::{Mission, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle, Waypoints};
 

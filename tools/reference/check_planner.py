@@ -40,7 +40,6 @@ for _v in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_v, "1")
 
 import argparse  # noqa: E402
-import copy  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
 import multiprocessing  # noqa: E402
@@ -96,7 +95,13 @@ class Fast:
     x, d, d_prev, x_prev -- the sample at which the vehicle has just reached
     the track's first waypoint (the first sample with x >= X_{n-1}) and the x
     of the sample before it (for the clipped piece [X_{n-1}, x_k], flown under
-    the previous depth, which belongs to J_n)."""
+    the previous depth, which belongs to J_n).
+
+    The batch step is the model's arithmetic rearranged for speed (the plant
+    update, theta and q in one product, the bottom as intercept + slope x, the
+    gains' signs folded): it agrees with auvref to ~1e-13 relative, which the
+    self-test checks.  With Kid = 0 the depth integrator has no effect and is
+    not tracked (it keeps its start value)."""
 
     def __init__(self, vehicle: ar.Vehicle, profile: ar.Profile, waypoints):
         v = vehicle
@@ -130,6 +135,12 @@ class Fast:
         dx0 = float(self.pdx[0])
         self.uniform = bool(np.all(np.abs(self.pdx - dx0) <= 1e-9 * dx0))
         self.inv_dx = 1.0 / dx0
+        self.slope = self.pdb / self.pdx
+        self.icpt = self.pb0 - self.slope * self.px0
+        # stacked one-step map: [eta; theta; q](k+1) = G eta(k) + H delta(k)
+        self.G = np.vstack((self.Ad, self.C @ self.Ad, self.CA @ self.Ad))
+        self.H = np.concatenate((self.Bd.ravel(), [self.C @ self.Bd.ravel(),
+                                                  self.CA @ self.Bd.ravel()])).reshape(no + 2, 1)
         self.steps = 0  # candidate-steps simulated (statistics)
 
     # bottom depth, exactly auvref.Profile.__call__'s formula
@@ -163,6 +174,8 @@ class Fast:
         S = np.array(S, dtype=float, copy=True)
         z = np.asarray(z, dtype=float)
         N = S.shape[1]
+        if N == 1:
+            return self._fly1(S, float(np.ravel(z)[0]), n)
         if z.shape != (N,):
             z = np.broadcast_to(z, (N,)).copy()
         Xa, Xb = self.X[n - 1], self.X[n]
@@ -196,43 +209,52 @@ class Fast:
 
         theta = C @ eta
         q = CA @ eta
+        esq = e * e
         out_S = np.empty((self.nrow, N))
         out_J = np.empty(N)
         out_h = np.empty(N)
         idx = np.arange(N)  # original column of each working candidate
         bXb = float(self.prof(Xb))
+        # constants of the rearranged (same-model, reordered-arithmetic) step
+        G, H = self.G, self.H
+        kdd_ts = kdd / Ts
+        skpt, skit, skdt = sigma * kpt, sigma * kit, sigma * kdt
+        half_deg = 0.5 * DEG
+        track_id = kid != 0.0
+        px0, inv_dx, nseg1 = self.px[0], self.inv_dx, self.nseg - 1
+        icpt, slope = self.icpt, self.slope
         guard = 0
         while True:
             if guard <= 0:
                 guard = int((Xb - float(x.max())) / U) - 1
-            # 1. reference is z (the sample is inside the track)
-            # 2. depth loop
+            # 2. depth loop (the sample is inside the track: reference z)
             e_d = z - d
-            ddot = (d - dp) / Ts
-            if kid != 0.0:
-                vk = -(kpd * e_d + kid * Id - kdd * ddot)
+            if track_id:
+                vk = kdd_ts * (d - dp) - kpd * e_d - kid * Id
             else:
-                vk = -(kpd * e_d + 0.0 - kdd * ddot)
+                vk = kdd_ts * (d - dp) - kpd * e_d
             thref = np.minimum(np.maximum(vk, -thmax), thmax)
+            #    pitch loop
             e_t = thref - theta
-            wk = sigma * (kpt * e_t + kit * Ith - kdt * q)
+            wk = skpt * e_t + skit * Ith - skdt * q
             delta = np.minimum(np.maximum(wk, -dmax), dmax)
-            if kid != 0.0:
-                skip = ((vk > thmax) & (e_d < 0.0)) | ((vk < -thmax) & (e_d > 0.0))
-                Id = Id + np.where(skip, 0.0, Ts * e_d)
+            #    conditional integration
+            if track_id:
+                Id = Id + np.where((vk * e_d < 0.0) & (vk != thref), 0.0, Ts * e_d)
+            if sigma > 0.0:
+                sat = (wk * e_t > 0.0) & (wk != delta)
             else:
-                Id = Id + Ts * e_d  # unused by the loop (kid = 0); kept as state
-            se = sigma * e_t
-            skip = (wk * se > 0.0) & (np.abs(wk) > dmax)
-            Ith = Ith + np.where(skip, 0.0, Ts * e_t)
-            # 3. plant
-            eta = Ad @ eta + Bd * delta
-            theta1 = C @ eta
+                sat = (wk * e_t < 0.0) & (wk != delta)
+            Ith = Ith + np.where(sat, 0.0, Ts * e_t)
+            # 3. plant: eta, theta and q of the next sample in one product
+            Y = G @ eta + H * delta
+            eta = Y[:no]
+            theta1 = Y[no]
+            q = Y[no + 1]
             # 4. kinematics
-            tb = (0.5 * (theta + theta1)) * DEG
+            tb = (theta + theta1) * half_deg
             x1 = x + U * np.cos(tb)
             d1 = d - U * np.sin(tb)
-            q = CA @ eta
             self.steps += x.shape[0]
             guard -= 1
             if guard <= 0:
@@ -244,9 +266,8 @@ class Fast:
                     dcb = np.where(x1[c] == Xb, d1c,
                                    dcur + (d1c - dcur) * (Xb - xc) / (x1[c] - xc))
                     ecb = bXb - h_r - dcb
-                    ec0 = e[c]
                     jj = idx[c]
-                    out_J[jj] = J[c] + (Xb - xc) * (ec0 * ec0 + ecb * ecb) / 4.0
+                    out_J[jj] = J[c] + (Xb - xc) * (esq[c] + ecb * ecb) / 4.0
                     out_h[jj] = np.minimum(hmin[c], bXb - dcb)
                     out_S[:no, jj] = eta[:, c]
                     out_S[self.I_ID, jj] = Id[c]
@@ -261,14 +282,93 @@ class Fast:
                     idx = idx[keep]
                     eta = eta[:, keep]
                     Id, Ith, x, d, z = Id[keep], Ith[keep], x[keep], d[keep], z[keep]
-                    x1, d1, e = x1[keep], d1[keep], e[keep]
+                    x1, d1, esq = x1[keep], d1[keep], esq[keep]
                     theta1, q, J, hmin = theta1[keep], q[keep], J[keep], hmin[keep]
-            # sample k+1 inside the track: full trapezoid segment
-            b1 = self.bottom(x1)
-            e1 = b1 - h_r - d1
-            J = J + (x1 - x) * (e * e + e1 * e1) / 4.0
-            hmin = np.minimum(hmin, b1 - d1)
+            # sample k+1 inside the track: a full trapezoid segment
+            if self.uniform:
+                i = ((x1 - px0) * inv_dx).astype(np.intp)
+                np.minimum(i, nseg1, out=i)
+                h1 = icpt.take(i) + slope.take(i) * x1 - d1
+            else:
+                h1 = self.bottom(x1) - d1
+            e1 = h1 - h_r
+            e1sq = e1 * e1
+            J = J + (x1 - x) * (esq + e1sq) * 0.25
+            hmin = np.minimum(hmin, h1)
             # 5. shift
+            dp = d
+            d = d1
+            x = x1
+            esq = e1sq
+            theta = theta1
+
+    def _fly1(self, S, z, n):
+        """fly() for one candidate on plain Python floats (numpy's per-call
+        overhead dominates a batch of one); the same arithmetic."""
+        v = self.v
+        no = self.no
+        rng = range(no)
+        Ad = [[float(a) for a in row] for row in self.Ad]
+        Bd = [float(b) for b in self.Bd.ravel()]
+        C = [float(c) for c in self.C]
+        CA = [float(c) for c in self.CA]
+        col = [float(u) for u in S[:, 0]]
+        eta = col[:no]
+        Id, Ith, x, d, dp, xp = col[no:no + 6]
+        Xa, Xb = self.X[n - 1], self.X[n]
+        h_r = self.h_r
+        Ts, U = v.sample_time, self.U
+        thmax, dmax = v.pitch_limit, v.elevator_limit
+        kpd, kid, kdd = v.kpd, v.kid, v.kdd
+        kpt, kit, kdt = v.kpt, v.kit, v.kdt
+        sigma = v.plant.sigma
+        prof = self.prof
+        if x > Xb:
+            raise ar.ModelError("track shorter than one step")
+        dc = d if x == Xa else dp + (d - dp) * (Xa - xp) / (x - xp)
+        ba = prof(Xa)
+        ec = ba - h_r - dc
+        b = prof(x)
+        e = b - h_r - d
+        J = (x - Xa) * (ec * ec + e * e) / 4.0
+        hmin = min(ba - dc, b - d)
+        theta = sum(C[j] * eta[j] for j in rng)
+        q = sum(CA[j] * eta[j] for j in rng)
+        bXb = prof(Xb)
+        sin, cos = math.sin, math.cos
+        while True:
+            e_d = z - d
+            ddot = (d - dp) / Ts
+            vk = -(kpd * e_d + kid * Id - kdd * ddot)
+            thref = min(max(vk, -thmax), thmax)
+            e_t = thref - theta
+            wk = sigma * (kpt * e_t + kit * Ith - kdt * q)
+            delta = min(max(wk, -dmax), dmax)
+            if kid != 0.0 and not ((vk > thmax and e_d < 0.0) or (vk < -thmax and e_d > 0.0)):
+                Id += Ts * e_d  # (with Kid = 0, I_d has no effect: not tracked)
+            se = sigma * e_t
+            if not ((wk > dmax and se > 0.0) or (wk < -dmax and se < 0.0)):
+                Ith += Ts * e_t
+            eta = [sum(Ad[i][j] * eta[j] for j in rng) + Bd[i] * delta for i in rng]
+            theta1 = sum(C[j] * eta[j] for j in rng)
+            tb = (0.5 * (theta + theta1)) * DEG
+            x1 = x + U * cos(tb)
+            d1 = d - U * sin(tb)
+            q = sum(CA[j] * eta[j] for j in rng)
+            self.steps += 1
+            if x1 >= Xb:
+                dcb = d1 if x1 == Xb else d + (d1 - d) * (Xb - x) / (x1 - x)
+                ecb = bXb - h_r - dcb
+                J += (Xb - x) * (e * e + ecb * ecb) / 4.0
+                hmin = min(hmin, bXb - dcb)
+                out = np.array(eta + [Id, Ith, x1, d1, d, x]).reshape(self.nrow, 1)
+                return np.array([J]), np.array([hmin]), out
+            b1 = prof(x1)
+            e1 = b1 - h_r - d1
+            J += (x1 - x) * (e * e + e1 * e1) / 4.0
+            h1 = b1 - d1
+            if h1 < hmin:
+                hmin = h1
             dp = d
             d = d1
             x = x1
@@ -353,7 +453,12 @@ def search_track(fm: Fast, S, n, k_best=6, n_coarse=201, n_fine=600, tol_z=0.005
     3. successive refinement: around the k_best local minima (of J, of J over
        the safe points, and of -hmin when nothing is safe yet), 10 new points
        in each neighbouring interval, until the neighbours are tol_z apart.
-    """
+
+    Returns best_z/best_J (unconstrained), best_safe_z/best_safe_J (None when
+    no evaluated depth is safe: feasible False), max_min_altitude, and
+    fallback_z/fallback_J: the least J among the depths whose min altitude is
+    within 1 mm of the highest (what a planner could fly where nothing is
+    safe)."""
     S = np.asarray(S, dtype=float).reshape(fm.nrow, 1)
     h_a = fm.h_a
     L = fm.X[n] - fm.X[n - 1]
@@ -426,6 +531,12 @@ def search_track(fm: Fast, S, n, k_best=6, n_coarse=201, n_fine=600, tol_z=0.005
                    best_safe_min_altitude=float(h[k]))
     else:
         res.update(best_safe_z=None, best_safe_J=None, best_safe_min_altitude=None)
+    # the best fallback where nothing is safe: the least J among the depths
+    # whose min altitude is within 1 mm of the highest one
+    jf = np.where(h >= h.max() - 1e-3, J, np.inf)
+    k = int(np.argmin(jf))
+    res.update(fallback_z=float(z[k]), fallback_J=float(J[k]),
+               fallback_min_altitude=float(h[k]))
     # the distinct local minima of J (for the report)
     mins = _pick_minima(z, J, np.ones(len(z), dtype=bool), 4, min_sep=max(3, len(z) // 50))
     res["local_minima"] = [[float(z[m]), float(J[m])] for m in mins]
@@ -451,23 +562,28 @@ def _track_band(fm: Fast, n):
     return min(bs), max(bs)
 
 
-def beam_search(fm: Fast, B=100, nz=32, seed=0, center=None, halfwidth=None):
-    """Best safe whole-line plan by beam search.
+def beam_search(fm: Fast, B=100, nz=32, seed=0, center=None, halfwidth=None,
+                n_local=6, keep=1, reserve=0.25):
+    """Best safe whole-line plans by beam search.
 
     Track by track, every kept partial plan (a start state) is extended by nz
     depths: a third spread over the reachable range (its two ends included:
     beyond them the pitch reference saturates over the whole track), two
     thirds over the band [min b - 2 h_r, max b - h_a + h_r] of the track, each
-    grid jittered per state.  Extensions that are unsafe on the new track are
-    dropped; the survivors are binned by their depth at the track's end (bins
-    of h_r/40) and the best of each bin kept; the next beam is the 3B/4 best
-    bins by accumulated J plus the B/4 shallowest other bins (a reserve for
-    walls further on).  Returns a dict (plan, per-track J and min altitude,
-    total J), or None with the track where every partial plan died.
+    grid jittered per state; then n_local more depths within one grid step of
+    each state's best safe one.  Extensions that are unsafe on the new track
+    are dropped; the survivors are binned by their depth at the track's end
+    (bins of h_r/40) and the best of each bin kept; the next beam is the
+    (1 - reserve) B best bins by accumulated J plus the reserve B shallowest
+    other bins (a reserve for walls further on).
 
     With `center` (a plan) and `halfwidth`, a focused pass: the nz depths of
     track n are spread over center_n +- halfwidth (center_n itself included)
-    and the bins are halfwidth/20 wide."""
+    and the bins are halfwidth/20 wide.
+
+    Returns a dict with the best plan (plan, per-track J and min altitude,
+    total J) and `finals`, up to `keep` distinct good plans; or, when every
+    partial plan died, safe_plan False and the track where it happened."""
     rng = np.random.default_rng(seed)
     h_r, h_a = fm.h_r, fm.h_a
     S = fm.start()
@@ -482,15 +598,16 @@ def beam_search(fm: Fast, B=100, nz=32, seed=0, center=None, halfwidth=None):
         L = fm.X[n] - fm.X[n - 1]
         nb = S.shape[1]
         ds = S[fm.I_D]
-        R = L * tan + 50.0
-        a = np.maximum(fm.lo, ds - R)
-        b = np.minimum(fm.hi, ds + R)
-        bmin, bmax = _track_band(fm, n)
-        ba = np.maximum(a, bmin - 2.0 * h_r)
-        bb = np.minimum(b, bmax - h_a + h_r)
-        bb = np.where(bb > ba, bb, b)
-        ba = np.where(bb > ba, ba, a)
         if center is None:
+            R = L * tan + 50.0
+            a = np.maximum(fm.lo, ds - R)
+            b = np.minimum(fm.hi, ds + R)
+            bmin, bmax = _track_band(fm, n)
+            ba = np.maximum(a, bmin - 2.0 * h_r)
+            bb = np.minimum(b, bmax - h_a + h_r)
+            inband = bb > ba
+            bb = np.where(inband, bb, b)
+            ba = np.where(inband, ba, a)
             nu = max(nz // 3, 3)
             nbnd = nz - nu
             u1 = (np.arange(nu - 2)[None, :] + rng.random((nb, nu - 2))) / (nu - 2)
@@ -498,16 +615,37 @@ def beam_search(fm: Fast, B=100, nz=32, seed=0, center=None, halfwidth=None):
             Z = np.concatenate((a[:, None], b[:, None],
                                 a[:, None] + (b - a)[:, None] * u1,
                                 ba[:, None] + (bb - ba)[:, None] * u2), axis=1)
+            step = (bb - ba) / nbnd
         else:
             c = float(center[n - 1])
             u = (np.arange(nz - 1)[None, :] + rng.random((nb, nz - 1))) / (nz - 1)
             Z = np.concatenate((np.full((nb, 1), c), c - halfwidth + 2.0 * halfwidth * u),
                                axis=1)
             Z = np.clip(Z, fm.lo, fm.hi)
+            step = np.full(nb, 2.0 * halfwidth / (nz - 1))
         parent = np.repeat(np.arange(nb), Z.shape[1])
         z = Z.ravel()
         J, h, S1 = fm.fly(S[:, parent], z, n)
         n_eval += len(z)
+        if n_local > 0:
+            # each state's best safe depth, refined within one grid step
+            key = np.where(h >= h_a, J, np.inf).reshape(nb, -1)
+            jb = np.argmin(key, axis=1)
+            has = np.isfinite(key[np.arange(nb), jb])
+            if has.any():
+                st = np.nonzero(has)[0]
+                zb = Z[st, jb[st]]
+                u = (np.arange(n_local)[None, :] + rng.random((len(st), n_local))) / n_local
+                Z2 = np.clip(zb[:, None] + step[st, None] * (2.0 * u - 1.0), fm.lo, fm.hi)
+                p2 = np.repeat(st, n_local)
+                z2 = Z2.ravel()
+                J2, h2, S2 = fm.fly(S[:, p2], z2, n)
+                n_eval += len(z2)
+                parent = np.concatenate((parent, p2))
+                z = np.concatenate((z, z2))
+                J = np.concatenate((J, J2))
+                h = np.concatenate((h, h2))
+                S1 = np.concatenate((S1, S2), axis=1)
         ok = np.nonzero(h >= h_a)[0]
         if len(ok) == 0:
             return {"safe_plan": False, "dead_track": n, "evaluations": n_eval,
@@ -515,28 +653,40 @@ def beam_search(fm: Fast, B=100, nz=32, seed=0, center=None, halfwidth=None):
                     "partial_plan": plans[int(np.argmin(acc))].tolist()}
         accn = acc[parent[ok]] + J[ok]
         order = ok[np.argsort(accn, kind="stable")]
-        accs = acc[parent[order]] + J[order]
-        bins = np.floor(S1[fm.I_D, order] / w)
-        _, first = np.unique(bins, return_index=True)
-        first.sort()  # representatives in accumulated-J order
-        reps = order[first]
-        take = list(reps[: (3 * B) // 4])
-        rest = reps[(3 * B) // 4:]
-        if len(rest):
-            rest = rest[np.argsort(S1[fm.I_D, rest], kind="stable")]
-            take += list(rest[: B - len(take)])
-        take = np.array(take)
+        if n == fm.M:
+            take = order  # the last track: keep every safe plan, best first
+        else:
+            bins = np.floor(S1[fm.I_D, order] / w)
+            _, first = np.unique(bins, return_index=True)
+            first.sort()  # representatives in accumulated-J order
+            reps = order[first]
+            nbest = B - int(round(reserve * B))
+            take = list(reps[:nbest])
+            rest = reps[nbest:]
+            if len(rest):
+                rest = rest[np.argsort(S1[fm.I_D, rest], kind="stable")]
+                take += list(rest[: B - len(take)])
+            take = np.array(take)
         par = parent[take]
         acc = acc[par] + J[take]
         plans = np.concatenate((plans[par], z[take][:, None]), axis=1)
         Jt = np.concatenate((Jt[par], J[take][:, None]), axis=1)
         ht = np.concatenate((ht[par], h[take][:, None]), axis=1)
         S = S1[:, take]
-        del accs
-    k = int(np.argmin(acc))
-    return {"safe_plan": True, "plan": plans[k].tolist(), "J": Jt[k].tolist(),
-            "min_altitude": ht[k].tolist(), "total_J": float(acc[k]),
-            "evaluations": n_eval}
+    # acc is sorted; distinct plans: a depth differs by > 10 zscale and the
+    # total J by > 1e-6 (two depths beyond reach fly the same saturated path)
+    finals = []
+    for k in range(len(acc)):
+        if all(np.max(np.abs(plans[k] - plans[j])) > 10.0 * zscale(fm)
+               and abs(acc[k] - acc[j]) > 1e-6 * acc[j] for j in finals):
+            finals.append(k)
+        if len(finals) >= keep:
+            break
+    res = [{"plan": plans[k].tolist(), "J": Jt[k].tolist(), "min_altitude": ht[k].tolist(),
+            "total_J": float(acc[k])} for k in finals]
+    out = {"safe_plan": True, "evaluations": n_eval, "finals": res}
+    out.update(res[0])
+    return out
 
 
 def refine_plan(fm: Fast, z, max_sweeps=4):
@@ -576,32 +726,57 @@ def refine_plan(fm: Fast, z, max_sweeps=4):
             "total_J": total, "evaluations": n_eval, "safe": bool((hs >= h_a).all())}
 
 
-def best_horizon_plan(fm: Fast, B=100, nz=32, seed=0, focus=(20.0, 5.0, 1.25, 0.3),
-                      sweeps=1):
-    """Wide beam search, then focused beam passes around the best plan so far
-    (half-widths `focus` x zscale m), then a coordinate-search polish."""
-    res = beam_search(fm, B=B, nz=nz, seed=seed)
-    if not res["safe_plan"]:
-        return res
-    res["passes"] = [res["total_J"]]
-    best = res
-    for k, hw in enumerate(focus):
-        r = beam_search(fm, B=B, nz=nz, seed=seed + 1 + k, center=best["plan"],
-                        halfwidth=hw * zscale(fm))
-        res["evaluations"] += r["evaluations"]
-        res["passes"].append(r["total_J"] if r["safe_plan"] else None)
-        if r["safe_plan"] and r["total_J"] < best["total_J"]:
-            best = r
-    out = dict(res)
-    out.update(plan=best["plan"], J=best["J"], min_altitude=best["min_altitude"],
-               total_J=best["total_J"])
+def best_horizon_plan(fm: Fast, B=100, nz=32, seed=0, focus=(20.0, 5.0, 1.25), starts=1,
+                      B_focus=50, sweeps=0):
+    """The reference's best safe whole-line plan: a wide beam search, then
+    for each of its `starts` best distinct plans, focused beam passes around
+    it (half-widths `focus` x zscale m, each centred on the best so far of
+    that start), then the last track re-optimized exactly (search_track) from
+    the state the best plan reaches, and optionally a coordinate search.
+
+    When the wide beam dies on a track after the first, it is retried with a
+    beam twice as wide, half of it the shallowest states, before concluding
+    that no safe plan was found (on the first track the search is exhaustive:
+    the start state is fixed and the full climb z = d_min is a candidate)."""
+    wide = beam_search(fm, B=B, nz=nz, seed=seed, keep=starts)
+    if not wide["safe_plan"] and wide["dead_track"] > 1:
+        retry = beam_search(fm, B=2 * B, nz=nz, seed=seed + 1, keep=starts, reserve=0.5)
+        retry["evaluations"] += wide["evaluations"]
+        retry["retried"] = True
+        wide = retry
+    if not wide["safe_plan"]:
+        return wide
+    out = {"safe_plan": True, "evaluations": wide["evaluations"],
+           "wide_total_J": [f["total_J"] for f in wide["finals"]], "starts": []}
+    best = None
+    for i, start in enumerate(wide["finals"]):
+        cur = start
+        passes = [cur["total_J"]]
+        for k, hw in enumerate(focus):
+            r = beam_search(fm, B=B_focus, nz=nz, seed=seed + 100 * (i + 1) + k,
+                            center=cur["plan"], halfwidth=hw * zscale(fm))
+            out["evaluations"] += r["evaluations"]
+            passes.append(r["total_J"] if r["safe_plan"] else None)
+            if r["safe_plan"] and r["total_J"] < cur["total_J"]:
+                cur = r
+        out["starts"].append(passes)
+        if best is None or cur["total_J"] < best["total_J"]:
+            best = cur
+    plan = list(best["plan"])
+    # the last track alone, exactly, from the state the plan reaches
+    M = fm.M
+    _, _, states = fm.fly_plan([plan])
+    r = search_track(fm, states[M - 1], M)
+    out["evaluations"] += r["evaluations"]
+    if r["feasible"] and r["best_safe_J"] < best["J"][-1]:
+        plan[-1] = r["best_safe_z"]
     if sweeps:
-        r = refine_plan(fm, best["plan"], max_sweeps=sweeps)
-        out["evaluations"] += r["evaluations"]
-        if r["total_J"] < out["total_J"]:
-            out.update(plan=r["plan"], J=r["J"], min_altitude=r["min_altitude"],
-                       total_J=r["total_J"])
-        out["passes"].append(out["total_J"])
+        rr = refine_plan(fm, plan, max_sweeps=sweeps)
+        out["evaluations"] += rr["evaluations"]
+        plan = rr["plan"]
+    Js, hs, _ = fm.fly_plan([plan])
+    out.update(plan=[float(v) for v in plan], J=Js[0].tolist(),
+               min_altitude=hs[0].tolist(), total_J=float(Js.sum()))
     return out
 
 
@@ -760,7 +935,15 @@ class CaseChecker:
 
     def horizon(self):
         if self._horizon is None:
-            self._horizon = best_horizon_plan(self.fm, B=self.beam, nz=self.nz, seed=self.seed)
+            hz = best_horizon_plan(self.fm, B=self.beam, nz=self.nz, seed=self.seed)
+            if hz["safe_plan"]:
+                # confirm the plan with the scalar reference
+                _, res = ar.evaluate_plan(self.vehicle, self.fm.prof, self.fm.X, hz["plan"])
+                hz["auvref_total_J"] = res["total_J"]
+                hz["auvref_min_altitude"] = res["min_altitude"]
+                if res["min_altitude"] < self.h_a:
+                    raise RuntimeError(f"{self.name}: beam plan unsafe in auvref")
+            self._horizon = hz
         return self._horizon
 
     def add(self, ok, what, msg):
@@ -865,8 +1048,9 @@ class CaseChecker:
                 self.add(ok, f"C2 track {n} [{key}]",
                          f"no safe depth in [{self.fm.lo:g}, {self.fm.hi:g}] (best min altitude "
                          f"{r['max_min_altitude']:.3f} m at z {r['z_max_min_altitude']:.2f} < h_a "
-                         f"{self.h_a:g}); tool status {st}, depth {t['depth']:.3f}, "
-                         f"min altitude {hmin:.3f}{note}")
+                         f"{self.h_a:g}; least J there {_g(r['fallback_J'])} at z "
+                         f"{r['fallback_z']:.3f}); tool status {st}, depth {t['depth']:.3f}, "
+                         f"min altitude {hmin:.3f}, J {_g(J)}{note}")
                 continue
             best = r["best_safe_J"]
             ratio = J / best if best > 0 else float("inf")
@@ -893,6 +1077,12 @@ class CaseChecker:
                 "resim_min_altitudes": [t["min_altitude"] for t in res["tracks"]],
                 "reference": hz}
         if hz["safe_plan"]:
+            self.info.append(
+                f"info C3 reference plan {self.name}: z {[round(v, 3) for v in hz['plan']]}, "
+                f"J {[float(_g(v)) for v in hz['J']]}, min altitude "
+                f"{[round(v, 3) for v in hz['min_altitude']]}, total {_g(hz['total_J'], 7)} "
+                f"(wide beam {_g(hz['wide_total_J'][0])}, focused passes "
+                f"{[float(_g(p)) if p else p for p in hz['starts'][0][1:]]})")
             best = hz["total_J"]
             ratio = tot / best
             info["ratio"] = ratio
@@ -984,7 +1174,7 @@ class SelfTool:
             elif r["feasible"]:
                 z, st = r["best_safe_z"], "converged"
             else:
-                z, st = r["z_max_min_altitude"], "infeasible"
+                z, st = r["fallback_z"], "infeasible"
             depths.append(z)
             sts.append(st)
             _, _, S = fm.fly(S, [z], n)
@@ -1013,18 +1203,18 @@ class SelfTool:
 
 
 def negative_tests(cc: CaseChecker, tool: SelfTool):
-    """Spoiled outputs that the checker must reject: [(what, detected)]."""
+    """Spoiled outputs that the checker must reject: [(what, detected, fails)]."""
     fm, h_a, M = cc.fm, cc.h_a, cc.fm.M
     out = []
 
-    def trial(key, doc, expect):
-        saved = (cc.checks, cc.data, cc.consistency)
-        cc.checks, cc.data, cc.consistency = [], {"runs": {}}, []
+    def trial(key, what, doc, expect):
+        saved = (cc.checks, cc.data, cc.consistency, cc.info)
+        cc.checks, cc.data, cc.consistency, cc.info = [], {"runs": {}}, [], []
         try:
             cc.check_run(key, json.loads(json.dumps(doc)))
             got = cc.checks
         finally:
-            cc.checks, cc.data, cc.consistency = saved
+            cc.checks, cc.data, cc.consistency, cc.info = saved
         fails = [line for ok, line in got if not ok]
         detected = all(any(e in line for line in fails) for e in expect)
         out.append((f"{key}: {what}", detected, fails))
@@ -1038,18 +1228,17 @@ def negative_tests(cc: CaseChecker, tool: SelfTool):
         z = float(np.clip(depths[-1] + k * zscale(fm), fm.lo, fm.hi))
         J, _, _ = fm.fly(states[M - 1], [z], M)
         if J[0] > 1.02 * r["best_J"] + 1.0:
-            what = f"track {M} depth {depths[-1]:.2f} -> {z:.2f} (J x{J[0] / r['best_J']:.3f})"
-            trial(key, plan_json(fm, depths[:-1] + [z], "track", "bfgs", sts, [3] * M),
+            trial(key, f"track {M} depth {depths[-1]:.2f} -> {z:.2f} (J x{J[0] / r['best_J']:.3f})",
+                  plan_json(fm, depths[:-1] + [z], "track", "bfgs", sts, [3] * M),
                   [f"C1 track {M} "])
             break
     # N2: 11 iterations on track 1
-    what = "11 iterations on track 1"
-    trial(key, plan_json(fm, depths, "track", "bfgs", sts, [11] + [3] * (M - 1)), ["C1 track 1 "])
+    trial(key, "11 iterations on track 1",
+          plan_json(fm, depths, "track", "bfgs", sts, [11] + [3] * (M - 1)), ["C1 track 1 "])
     # N6: a reported J that is not the flight's
     doc = plan_json(fm, depths, "track", "bfgs", sts, [3] * M)
     doc["tracks"][0]["J"] *= 0.9
-    what = "track 1 J reported x0.9"
-    trial(key, doc, ["C4 resim"])
+    trial(key, "track 1 J reported x0.9", doc, ["C4 resim"])
 
     key = "track_constrained_bfgs"
     depths, sts = tool.plan(key)
@@ -1062,17 +1251,17 @@ def negative_tests(cc: CaseChecker, tool: SelfTool):
             dz[k - 1] = r["best_z"]
             doc = plan_json(fm, dz, "track", "bfgs", sts, [3] * M)
             doc["tracks"][k - 1]["safe"] = True
-            what = (f"track {k} unsafe depth {r['best_z']:.2f} (min alt "
-                    f"{r['best_min_altitude']:.2f}) claimed safe")
-            trial(key, doc, [f"C2 track {k} ", "C4 resim"])
+            trial(key, f"track {k} unsafe depth {r['best_z']:.2f} (min alt "
+                  f"{r['best_min_altitude']:.2f}) claimed safe", doc,
+                  [f"C2 track {k} ", "C4 resim"])
             break
     for k in range(M, 0, -1):
         if sts[k - 1] != "infeasible":
             # N4: a feasible track said infeasible
             s2 = list(sts)
             s2[k - 1] = "infeasible"
-            what = f"feasible track {k} reported infeasible"
-            trial(key, plan_json(fm, depths, "track", "bfgs", s2, [3] * M), [f"C2 track {k} "])
+            trial(key, f"feasible track {k} reported infeasible",
+                  plan_json(fm, depths, "track", "bfgs", s2, [3] * M), [f"C2 track {k} "])
             break
     for k in range(1, M + 1):
         if sts[k - 1] == "infeasible":
@@ -1082,8 +1271,8 @@ def negative_tests(cc: CaseChecker, tool: SelfTool):
             doc = plan_json(fm, depths, "track", "bfgs", s2, [3] * M)
             doc["tracks"][k - 1]["safe"] = True
             doc["safe"] = True
-            what = f"infeasible track {k} claimed converged and safe"
-            trial(key, doc, [f"C2 track {k} ", "C4 resim"])
+            trial(key, f"infeasible track {k} claimed converged and safe", doc,
+                  [f"C2 track {k} ", "C4 resim"])
             break
 
     key = "horizon_bfgs"
@@ -1099,15 +1288,15 @@ def negative_tests(cc: CaseChecker, tool: SelfTool):
         ok = np.nonzero((h >= h_a + 0.05) & (tot > 1.15 * Jbest))[0]
         if len(ok):
             i = ok[int(np.argmin(tot[ok]))]
-            what = f"safe last depth {cand[i]:.2f}, total J x{tot[i] / Jbest:.3f}"
-            trial(key, plan_json(fm, plan[:-1] + [float(cand[i])], "horizon", "bfgs"),
+            trial(key, f"safe last depth {cand[i]:.2f}, total J x{tot[i] / Jbest:.3f}",
+                  plan_json(fm, plan[:-1] + [float(cand[i])], "horizon", "bfgs"),
                   ["C3 horizon"])
         # N8: the unconstrained track plan, unsafe, as the horizon plan
         du, su = tool.plan("track_unconstrained_bfgs")
         _, res = ar.evaluate_plan(fm.v, fm.prof, fm.X, du)
         if res["min_altitude"] < h_a - 0.05:
-            what = f"unsafe plan (min alt {res['min_altitude']:.2f})"
-            trial(key, plan_json(fm, du, "horizon", "bfgs"), ["C3 horizon"])
+            trial(key, f"unsafe plan (min alt {res['min_altitude']:.2f})",
+                  plan_json(fm, du, "horizon", "bfgs"), ["C3 horizon"])
     return out
 
 
