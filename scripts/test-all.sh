@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test of the project, host and target, doing its own set-up.
-# This is the README's test command; CI (.ci/run) calls it too.
+# This is the README's test command; CI (.ci/run) calls it too. The
+# on-target part (scripts/qemu-test.sh) installs qemu-system-arm and
+# defmt-print when missing (scripts/qemu-setup.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,5 +24,8 @@ say "target: the library builds for Cortex-M4F (thumbv7em-none-eabihf), with and
 cargo build --lib --release --target thumbv7em-none-eabihf
 cargo build --lib --release --target thumbv7em-none-eabihf --features defmt
 cargo build --lib --release --target thumbv7m-none-eabi
+
+say "target: on-target tests under QEMU (Cortex-M4F, M7, M3), panic-freedom proof, defmt log"
+bash scripts/qemu-test.sh
 
 say "all tests passed"

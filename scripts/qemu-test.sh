@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Every on-target check under QEMU; scripts/test-all.sh (the README's test
+# command) and .ci/run call it. Fails if any test fails.
+#
+#   1. `cargo qemu-test`: the golden fixtures, the paper's plans bit for bit
+#      and the smoke test on the Cortex-M4F (mps2-an386);
+#   2. the smoke test on the Cortex-M7 (mps2-an500) and on the soft-float
+#      Cortex-M3 (lm3s6965evb, thumbv7m-none-eabi);
+#   3. the panic-freedom proof: examples/qemu_panic_never.rs links with
+#      panic-never in release, for both targets, and runs on the M4F;
+#   4. the defmt log example, decoded (cargo qemu-log).
+# The benchmarks are scripts/qemu-bench.sh (CI runs them too).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+say() { printf '\n==> %s\n' "$*"; }
+bash scripts/qemu-setup.sh
+
+say "target: cargo qemu-test (Cortex-M4F, QEMU mps2-an386): fixtures, plans, smoke"
+cargo qemu-test
+
+say "target: smoke test on the Cortex-M7 (QEMU mps2-an500)"
+QEMU_MACHINE=mps2-an500 cargo test --release --target thumbv7em-none-eabihf --test qemu_smoke
+
+say "target: smoke test on the soft-float Cortex-M3 (QEMU lm3s6965evb)"
+cargo test --release --target thumbv7m-none-eabi --test qemu_smoke
+
+say "target: panic-freedom proof (panic-never links in release), M4F and M3; run on the M4F"
+cargo build --release --target thumbv7m-none-eabi --example qemu_panic_never
+cargo run --release --target thumbv7em-none-eabihf --example qemu_panic_never
+
+say "target: the planner's progress as a decoded defmt log (cargo qemu-log)"
+cargo qemu-log
+
+say "all on-target tests passed"
