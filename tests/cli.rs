@@ -24,7 +24,11 @@ fn tool() -> PathBuf {
     let p = dir
         .join("examples")
         .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
-    assert!(p.exists(), "{} not built (run via cargo test)", p.display());
+    assert!(
+        p.exists(),
+        "{} not built: run `cargo build --examples` first (scripts/test-all.sh does)",
+        p.display()
+    );
     p
 }
 
