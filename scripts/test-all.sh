@@ -14,9 +14,6 @@ for t in thumbv7em-none-eabihf thumbv7m-none-eabi; do
 done
 
 say "host: cargo test (unit, golden fixtures, tool interface, doctests)"
-# tests/cli.rs runs target/debug/examples/plan, which `cargo test
-# --all-targets` builds only in test mode: build it first (fresh machine).
-cargo build --examples
 # tests/cli.rs runs the real `plan` binary: build the examples as binaries
 # first (`--all-targets` alone builds them only as test harnesses).
 cargo build --examples
