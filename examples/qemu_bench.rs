@@ -208,7 +208,7 @@ mod firmware {
         // Receding horizon, K = 5 (the library's default), call by call;
         // the first call is cold (scan and five tracks jointly), the later
         // ones are warm-started. On the soft-float M3 the cold call alone
-        // is over 1e11 instructions (about ten minutes in QEMU): skipped
+        // runs tens of billions of instructions (minutes in QEMU): skipped
         // unless the build sets AUVNAV_BENCH_HORIZON.
         if HORIZON {
             let Ok(mut planner) = Planner::<TRACKS>::new(paper::horizon_config()) else {
@@ -237,7 +237,7 @@ mod firmware {
             }
         } else {
             hprintln!(
-                "skip|horizon solves (Planner::<5>) not run on this soft-float build: over 1e11 instructions; AUVNAV_BENCH_HORIZON=1 cargo qemu-bench-m3 runs them"
+                "skip|horizon solves (Planner::<5>) not run on this soft-float build (tens of billions of instructions, minutes in QEMU); AUVNAV_BENCH_HORIZON=1 cargo qemu-bench-m3 runs them"
             );
         }
 

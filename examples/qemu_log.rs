@@ -1,11 +1,11 @@
 //! The planner's progress on the target, as a defmt log decoded on the
 //! host: the paper's line `us_monterey_canyon_1` (C-AUV #4, `h_r = 80 m`,
 //! `h_a = 60 m`) planned track-wise (`Planner::<1>`, the paper's method,
-//! about 10 s in QEMU), printing for every track the optimizer's objective
+//! a few seconds in QEMU), printing for every track the optimizer's objective
 //! at each iteration (`Plan::history`), then the track's outcome: depth,
 //! status, safety, minimum altitude, J, iterations and evaluations. (The
-//! receding horizon's first call alone runs 1.3e10 instructions, about a
-//! minute in QEMU; `tests/qemu_plan.rs` runs it.)
+//! receding horizon's cold first call is by far the costliest solve, see
+//! BENCHMARKS.md; `tests/qemu_plan.rs` runs it.)
 //!
 //! ```sh
 //! cargo qemu-log                   # Cortex-M4F under QEMU, decoded by defmt-print

@@ -94,7 +94,7 @@ mod firmware {
         line("  flash .vector_table ", s.vectors, " B\n");
         line(
             "  RAM .data+.bss+.uninit ",
-            s.data + s.bss + s.uninit,
+            s.data.saturating_add(s.bss).saturating_add(s.uninit),
             " B\n",
         );
         line("  stack used by the line's planning ", used, " B\n");

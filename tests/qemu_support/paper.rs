@@ -154,11 +154,12 @@ pub fn smoke() -> Result<Smoke, auvnav::Error> {
     let line = Scenario::new(&vehicle, &bottom, &waypoints, Mission::default())?;
     let mut out = Smoke::default();
     let p = vehicle.plant();
-    for i in 0..3 {
-        for j in 0..3 {
-            out.ad[3 * i + j] = p.ad()[(i, j)];
-        }
-        out.bd[i] = p.bd()[i];
+    // Row-major, as `expected.rs` lists it (nalgebra stores columns).
+    for (slot, v) in out.ad.iter_mut().zip(p.ad().transpose().iter()) {
+        *slot = *v;
+    }
+    for (slot, v) in out.bd.iter_mut().zip(p.bd().iter()) {
+        *slot = *v;
     }
     let start = line.start_state(line.default_initial_depth());
     let e = line.evaluate::<TRACKS>(&start, 0, &SMOKE_DEPTHS)?;
@@ -169,15 +170,11 @@ pub fn smoke() -> Result<Smoke, auvnav::Error> {
     out.grad_violation = e.grad_violation;
     out.end_x = e.end.x();
     out.end_depth = e.end.depth();
-    let last = TRACKS - 1;
+    let last = TRACKS.saturating_sub(1);
+    let (first_tracks, _) = SMOKE_DEPTHS.split_at(last);
     let mut scores = [auvnav::TrackScore::default(); TRACKS];
-    let state = line.simulate(
-        &start,
-        0,
-        &SMOKE_DEPTHS[..last],
-        &mut scores[..last],
-        |_| {},
-    )?;
+    let (first_scores, _) = scores.split_at_mut(last);
+    let state = line.simulate(&start, 0, first_tracks, first_scores, |_| {})?;
     let mut planner = Planner::<1>::new(trackwise_config())?;
     out.last_track = TrackPlan::of(&planner.plan(&line, &state, last)?);
     Ok(out)
