@@ -53,8 +53,10 @@ mod firmware {
 
     /// Whether the horizon solves run: always with hardware floating point,
     /// on request (`AUVNAV_BENCH_HORIZON` at build time) on the M3.
-    const HORIZON: bool =
-        cfg!(target_abi = "eabihf") || option_env!("AUVNAV_BENCH_HORIZON").is_some();
+    /// (`AUVNAV_BENCH_QUICK` at build time skips them everywhere, for a
+    /// quick look at the step and the track-wise solves while profiling.)
+    const HORIZON: bool = option_env!("AUVNAV_BENCH_QUICK").is_none()
+        && (cfg!(target_abi = "eabihf") || option_env!("AUVNAV_BENCH_HORIZON").is_some());
 
     #[panic_handler]
     fn panic(info: &core::panic::PanicInfo) -> ! {

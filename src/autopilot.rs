@@ -29,7 +29,7 @@
 //!   from the kinematics (nose-down goes deeper) and never changes.
 
 use crate::error::{ConfigError, non_negative, positive};
-use crate::num::clamp_sym;
+use crate::num::clamp;
 use crate::plant::TransferFunction;
 
 /// Gains of one PID loop. Units depend on the loop (see
@@ -223,7 +223,7 @@ impl Autopilot {
     /// The cascade proper, on the depth error `e_d = r - d` (m) and the
     /// depth rate `ḋ` (m/s), which the simulation computes from compensated
     /// depths. Updates both integrators after computing `δ` (contract §7).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn cascade(
         &self,
         depth_integral: &mut f32,
@@ -240,7 +240,7 @@ impl Autopilot {
             d: g.kd * depth_rate,
         };
         let v = depth_terms.p + depth_terms.i + depth_terms.d;
-        let (pitch_ref, pitch_ref_linear) = clamp_sym(v, self.cfg.pitch_limit);
+        let pitch_ref = clamp(v, self.cfg.pitch_limit);
 
         let e_t = pitch_ref - pitch;
         let g = &self.signed_pitch;
@@ -250,22 +250,27 @@ impl Autopilot {
             d: -g.kd * pitch_rate,
         };
         let w = pitch_terms.p + pitch_terms.i + pitch_terms.d;
-        let (elevator, elevator_linear) = clamp_sym(w, self.cfg.elevator_limit);
+        let elevator = clamp(w, self.cfg.elevator_limit);
 
         // Conditional integration: hold an integrator only while its output
         // is saturated and integrating would drive it further out. The depth
-        // loop's output is −(…), so a negative error pushes it up.
-        let depth_integrating =
-            !((v > self.cfg.pitch_limit && e_d < 0.0) || (v < -self.cfg.pitch_limit && e_d > 0.0));
-        let se = self.sign * e_t;
-        let pitch_integrating = !((w > self.cfg.elevator_limit && se > 0.0)
-            || (w < -self.cfg.elevator_limit && se < 0.0));
+        // loop's output is −(…), so a negative error pushes it up: it holds
+        // on `v > θmax` with `e_d < 0` and on `v < −θmax` with `e_d > 0`.
+        // With the clamp's excess `v − θref` (zero inside the limits, of
+        // the sign of `v` outside) that is `(v − θref) e_d < 0`. The pitch
+        // loop likewise, with its sign `σ`: it holds on `w > δmax` with
+        // `σ e_θ > 0` and on `w < −δmax` with `σ e_θ < 0`, that is
+        // `(w − δ) σ e_θ > 0`. (One product and compare each, no branches.)
+        let depth_integrating = (v - pitch_ref) * e_d >= 0.0;
+        let pitch_integrating = (w - elevator) * (self.sign * e_t) <= 0.0;
         if depth_integrating {
             *depth_integral += self.sample_time * e_d;
         }
         if pitch_integrating {
             *pitch_integral += self.sample_time * e_t;
         }
+        let pitch_ref_linear = pitch_ref == v;
+        let elevator_linear = elevator == w;
         Command {
             pitch_ref,
             elevator,

@@ -27,18 +27,18 @@ pub fn expm<const N: usize>(m: &SMatrix<f32, N, N>) -> Option<SMatrix<f32, N, N>
     Some(SMatrix::identity() + e)
 }
 
-/// Zero-order-hold discretization of `dη/dt = A η + B δ` over `ts` seconds
-/// with `B = e1` (the controllable canonical form):
-/// returns `(Ad, Bd) = (exp(A ts), ∫_0^ts exp(A τ) dτ · e1)`.
+/// Zero-order-hold discretization of `dη/dt = A η + B δ` over `ts` seconds:
+/// returns `(Ad, Bd) = (exp(A ts), ∫_0^ts exp(A τ) dτ · B)`.
 ///
 /// Returns `None` when the inputs are not finite or `||A ts||` is too large.
 pub fn zoh<const N: usize>(
     a: &SMatrix<f32, N, N>,
+    b: &SMatrix<f32, N, 1>,
     ts: f32,
 ) -> Option<(SMatrix<f32, N, N>, SMatrix<f32, N, 1>)> {
     let (e, f) = expm1_phi1(&(a * ts), ts)?;
     let ad = SMatrix::identity() + e;
-    let bd = f.column(0).into_owned();
+    let bd = f * b;
     (ad.iter().chain(bd.iter()).all(|v| v.is_finite())).then_some((ad, bd))
 }
 
@@ -132,7 +132,12 @@ mod tests {
         // dη/dt = -a η + δ: Ad = e^{-a T}, Bd = (1 - e^{-a T}) / a.
         let a = 0.7_f32;
         let t = 3.0_f32;
-        let (ad, bd) = zoh(&SMatrix::<f32, 1, 1>::new(-a), t).unwrap();
+        let (ad, bd) = zoh(
+            &SMatrix::<f32, 1, 1>::new(-a),
+            &SMatrix::<f32, 1, 1>::new(1.0),
+            t,
+        )
+        .unwrap();
         assert!(close(ad[0], libm::expf(-a * t), 1e-6));
         assert!(close(bd[0], (1.0 - libm::expf(-a * t)) / a, 1e-6));
     }
@@ -142,7 +147,7 @@ mod tests {
         // η = [v, p]: Ad = [[1,0],[T,1]], Bd = [T, T²/2], exactly.
         let m = Matrix2::new(0.0, 0.0, 1.0, 0.0);
         let t = 1e-3_f32;
-        let (ad, bd) = zoh(&m, t).unwrap();
+        let (ad, bd) = zoh(&m, &nalgebra::Vector2::new(1.0, 0.0), t).unwrap();
         assert!(close(ad[(1, 0)], t, 1e-7));
         assert!(close(bd[1], t * t / 2.0, 1e-6));
     }

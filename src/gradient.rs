@@ -69,7 +69,7 @@ impl<const N: usize, const K: usize> Tangents<N, K> {
     }
 
     /// `∂e` at a piece end.
-    #[inline]
+    #[inline(always)]
     fn de(&self, at: EndAt, slope_ratio: f32) -> SVector<f32, K> {
         match at {
             EndAt::Start { slope } => self.x_prev * slope - self.d_prev,
@@ -82,7 +82,7 @@ impl<const N: usize, const K: usize> Tangents<N, K> {
     }
 
     /// `∂x` at a piece end (zero at a fixed waypoint).
-    #[inline]
+    #[inline(always)]
     fn dx(&self, at: EndAt) -> SVector<f32, K> {
         match at {
             EndAt::Start { .. } => self.x_prev,
@@ -93,7 +93,7 @@ impl<const N: usize, const K: usize> Tangents<N, K> {
 }
 
 impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
-    #[inline]
+    #[inline(always)]
     fn step(&mut self, v: &Vehicle<N>, lin: &StepLin) {
         let plant = v.plant();
         let ap = v.autopilot();
@@ -101,8 +101,8 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
         let ts = plant.sample_time();
         let (gd, gt) = (&cfg.depth_pid, &cfg.pitch_pid);
 
-        let pitch = self.eta.tr_mul(plant.c());
-        let pitch_rate = self.eta.tr_mul(plant.ca());
+        let pitch = plant.pitch_of(&self.eta);
+        let pitch_rate = plant.pitch_rate_of(&self.eta);
         let mut e_d = -self.d;
         if let Some(r) = e_d.get_mut(lin.slot) {
             *r += 1.0;
@@ -128,7 +128,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
             self.pitch_integral += e_t * ts;
         }
         self.eta = plant.ad() * self.eta + plant.bd() * elevator.transpose();
-        let pitch_next = self.eta.tr_mul(plant.c());
+        let pitch_next = plant.pitch_of(&self.eta);
         let mean = (pitch + pitch_next) * (0.5 * DEG);
         let step = v.speed() * ts;
         self.d_prev = self.d;
@@ -137,7 +137,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
         self.x -= mean * (step * lin.sin);
     }
 
-    #[inline]
+    #[inline(always)]
     fn piece(&mut self, _slot: usize, p: &PieceLin) {
         let ratio = p.dd / p.dx;
         let de_lo = self.de(p.lo.at, ratio);

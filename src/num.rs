@@ -5,11 +5,11 @@
 //! 1000-5000 m. In plain f32 each addition loses up to half an ulp (0.24 mm
 //! at 4000 m), and because the increment is nearly constant the loss is
 //! systematic: after a 4 km line `x` would be off by metres, moving every
-//! waypoint switch. Compensated (Knuth two-sum) accumulation keeps the exact
+//! waypoint switch. Compensated (Dekker's Fast2Sum) accumulation keeps the exact
 //! rounding error of every addition in a second f32, so the f32 core tracks
-//! an f64 reference to about 1e-6 m at a cost of five extra additions.
+//! an f64 reference to about 1e-6 m at a cost of three extra additions.
 
-/// A value kept as an unevaluated sum `hi + lo` (Knuth's two-sum).
+/// A value kept as an unevaluated sum `hi + lo` (Dekker's Fast2Sum).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Comp {
     hi: f32,
@@ -18,24 +18,28 @@ pub(crate) struct Comp {
 
 impl Comp {
     /// A compensated value equal to `v`.
-    #[inline]
+    #[inline(always)]
     pub(crate) const fn new(v: f32) -> Self {
         Self { hi: v, lo: 0.0 }
     }
 
     /// The value rounded to one f32.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn value(self) -> f32 {
         self.hi + self.lo
     }
 
     /// `self + v`, keeping the rounding error of the addition.
-    #[inline]
+    ///
+    /// Dekker's Fast2Sum: `s + err == hi + v` exactly when `|hi| >= |v|`,
+    /// which holds for a position or depth and its per-step increment
+    /// (0.15 m by default) except within one increment of zero, where the
+    /// error term itself is off by at most an ulp of the increment (about
+    /// 1e-8 m): two additions fewer per step than Knuth's TwoSum.
+    #[inline(always)]
     pub(crate) fn add(self, v: f32) -> Self {
-        // Knuth's TwoSum: s + err == hi + v exactly.
         let s = self.hi + v;
-        let bv = s - self.hi;
-        let err = (self.hi - (s - bv)) + (v - bv);
+        let err = v - (s - self.hi);
         Self {
             hi: s,
             lo: self.lo + err,
@@ -44,13 +48,13 @@ impl Comp {
 
     /// `self - c`, accurate when `self` and `c` are close (the `hi - c` part
     /// is then exact by Sterbenz' lemma).
-    #[inline]
+    #[inline(always)]
     pub(crate) fn minus(self, c: f32) -> f32 {
         (self.hi - c) + self.lo
     }
 
     /// `self - other`, accurate when both are close.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn diff(self, other: Self) -> f32 {
         (self.hi - other.hi) + (self.lo - other.lo)
     }
@@ -66,7 +70,7 @@ pub(crate) struct Sum {
 }
 
 impl Sum {
-    #[inline]
+    #[inline(always)]
     pub(crate) fn add(&mut self, v: f32) {
         let y = v - self.c;
         let t = self.s + y;
@@ -74,7 +78,7 @@ impl Sum {
         self.s = t;
     }
 
-    #[inline]
+    #[inline(always)]
     pub(crate) fn value(self) -> f32 {
         self.s + self.c
     }
@@ -85,13 +89,18 @@ impl Sum {
 /// The vehicle's mean pitch stays well inside ±90° (the pitch reference is
 /// limited to less than 90° and the step fails beyond it), where a short
 /// polynomial beats libm's `sinf`/`cosf` by a wide margin on a Cortex-M4F
-/// (their kernels work in f64, which that FPU does not have). The odd
-/// degree-9 and even degree-10 polynomials below are near-minimax fits on
-/// `[-π/2, π/2]`; evaluated in f32 their error is at most 1.8e-7 (sin) and
-/// 1.3e-7 (cos), two to three times f32 rounding, checked by the unit test
-/// over the whole interval. Outside it, libm is used.
-#[inline]
+/// (their kernels work in f64, which that FPU does not have). Two pairs of
+/// near-minimax polynomials: on `|x| <= π/4` ([`sin_cos_short`], where a
+/// cruising vehicle flies) the odd degree-7 and even degree-8 ones, on
+/// `π/4 < |x| <= π/2` the odd degree-9 and even degree-10 ones; evaluated in
+/// f32 their error is at most 1.8e-7 (sin) and 1.3e-7 (cos), two to three
+/// times f32 rounding, checked by the unit test over the whole interval.
+/// Outside it, libm is used.
+#[inline(always)]
 pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
+    if libm::fabsf(x) <= SHORT {
+        return sin_cos_short(x);
+    }
     // NaN takes the libm branch too (and stays NaN).
     if libm::fabsf(x) > core::f32::consts::FRAC_PI_2 || x.is_nan() {
         return (libm::sinf(x), libm::cosf(x));
@@ -101,6 +110,25 @@ pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
     let c = 1.0 + x2 * (COS[0] + x2 * (COS[1] + x2 * (COS[2] + x2 * (COS[3] + x2 * COS[4]))));
     (s, c)
 }
+
+/// Where [`sin_cos_short`] applies: `|x| <= π/4` (45°).
+pub(crate) const SHORT: f32 = core::f32::consts::FRAC_PI_4;
+
+/// `(sin x, cos x)` for `|x| <= π/4` (radians; not checked): the degree-7
+/// and degree-8 polynomials of [`sin_cos`] (their own error below 3e-9).
+#[inline(always)]
+pub(crate) fn sin_cos_short(x: f32) -> (f32, f32) {
+    let x2 = x * x;
+    let s = x + x * (x2 * (SIN_SHORT[0] + x2 * (SIN_SHORT[1] + x2 * SIN_SHORT[2])));
+    let c =
+        1.0 + x2 * (COS_SHORT[0] + x2 * (COS_SHORT[1] + x2 * (COS_SHORT[2] + x2 * COS_SHORT[3])));
+    (s, c)
+}
+
+/// `sin x = x (1 + Σ SIN_SHORT[k] x^(2k+2))` on `[-π/4, π/4]`.
+const SIN_SHORT: [f32; 3] = [-0.166_666_55, 0.008_332_18, -0.000_195_17];
+/// `cos x = 1 + Σ COS_SHORT[k] x^(2k+2)` on `[-π/4, π/4]`.
+const COS_SHORT: [f32; 4] = [-0.5, 0.041_666_623, -0.001_388_676_3, 2.439_045_1e-5];
 
 /// `sin x = x (1 + Σ SIN[k] x^(2k+2))` on `[-π/2, π/2]`.
 const SIN: [f32; 4] = [-0.166_666_48, 0.008_332_9, -0.000_198_008_97, 2.590_488e-6];
@@ -113,19 +141,32 @@ const COS: [f32; 5] = [
     -2.605_149_2e-7,
 ];
 
+/// The lesser of `a` and `b`, inline: `f32::min` is an out-of-line
+/// `fminf` call on a Cortex-M4 (no `VMINNM`). Not NaN-aware; the callers
+/// compare finite values.
+#[inline(always)]
+pub(crate) fn min(a: f32, b: f32) -> f32 {
+    if b < a { b } else { a }
+}
+
+/// The greater of `a` and `b`, inline (see [`min`]).
+#[inline(always)]
+pub(crate) fn max(a: f32, b: f32) -> f32 {
+    if b > a { b } else { a }
+}
+
 /// Degrees to radians, as f32.
 pub(crate) const DEG: f32 = core::f32::consts::PI / 180.0;
 
-/// `v` clamped to `[-limit, limit]`, and whether it lay inside (the
-/// derivative of the clamp is 1 inside and 0 outside).
-#[inline]
-pub(crate) fn clamp_sym(v: f32, limit: f32) -> (f32, bool) {
+/// `v` clamped to `[-limit, limit]` (NaN stays NaN).
+#[inline(always)]
+pub(crate) fn clamp(v: f32, limit: f32) -> f32 {
     if v > limit {
-        (limit, false)
+        limit
     } else if v < -limit {
-        (-limit, false)
+        -limit
     } else {
-        (v, true)
+        v
     }
 }
 
@@ -149,6 +190,17 @@ mod tests {
         assert!(err_plain > 0.1, "plain f32 drift {err_plain}");
         assert!(err_comp < 1e-3, "compensated drift {err_comp}");
         assert!(f64::from(comp.minus(4500.0)) - (exact - 4500.0) < 1e-4);
+        // Across zero (a depth at the surface), where Fast2Sum's magnitude
+        // condition fails for a step or two: still within 1e-6 m.
+        let mut comp = Comp::new(-3.0);
+        let mut exact = -3.0_f64;
+        for k in 0..400 {
+            let v = if k < 300 { 0.1499 } else { -0.1501 };
+            comp = comp.add(v);
+            exact += f64::from(v);
+            let held = f64::from(comp.hi) + f64::from(comp.lo);
+            assert!((held - exact).abs() < 1e-6, "at {k}: {held} vs {exact}");
+        }
     }
 
     #[test]
@@ -179,6 +231,17 @@ mod tests {
         }
         assert!(es <= 1.8e-7, "sin error {es:e}");
         assert!(ec <= 1.3e-7, "cos error {ec:e}");
+        // The short pair, on the range the simulation's fast path uses.
+        let (mut es, mut ec) = (0.0_f64, 0.0_f64);
+        for i in 0..=n {
+            let x = -SHORT + 2.0 * SHORT * (i as f32) / (n as f32);
+            let (s, c) = sin_cos_short(x);
+            let xd = f64::from(x);
+            es = es.max((f64::from(s) - libm::sin(xd)).abs());
+            ec = ec.max((f64::from(c) - libm::cos(xd)).abs());
+        }
+        assert!(es <= 1.0e-7, "short sin error {es:e}");
+        assert!(ec <= 1.0e-7, "short cos error {ec:e}");
         // Exact where it matters most, and libm outside the range.
         assert_eq!(sin_cos(0.0), (0.0, 1.0));
         assert_eq!(sin_cos(2.0), (libm::sinf(2.0), libm::cosf(2.0)));
@@ -187,9 +250,10 @@ mod tests {
     }
 
     #[test]
-    fn clamp_reports_linearity() {
-        assert_eq!(clamp_sym(3.0, 2.0), (2.0, false));
-        assert_eq!(clamp_sym(-3.0, 2.0), (-2.0, false));
-        assert_eq!(clamp_sym(1.0, 2.0), (1.0, true));
+    fn clamp_is_symmetric() {
+        assert_eq!(clamp(3.0, 2.0), 2.0);
+        assert_eq!(clamp(-3.0, 2.0), -2.0);
+        assert_eq!(clamp(1.0, 2.0), 1.0);
+        assert!(clamp(f32::NAN, 2.0).is_nan());
     }
 }

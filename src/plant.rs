@@ -1,22 +1,30 @@
 //! Pitch dynamics: the vehicle's identified transfer function, realized and
 //! discretized exactly as the autopilot's sample-and-hold sees it.
 //!
-//! A `θ(s)/δ(s) = N(s)/D(s)` (deg/deg) with `D` of order `n <= N` becomes
-//! the controllable canonical form (the realization `scipy.signal.tf2ss`
-//! gives, so reference values can be compared entry by entry):
+//! A `θ(s)/δ(s) = N(s)/D(s)` (deg/deg) with `D(s) = s^n + a1 s^(n-1) + … +
+//! an` of order `n <= N` becomes the *observability* canonical form, whose
+//! states are the pitch, the pitch rate and (from the third on) higher
+//! derivatives less their input terms:
 //!
 //! ```text
-//!       | -a1 -a2 … -an |        | 1 |
-//!   A = |  1   0  …  0  |    B = | 0 |    C = [b1 … bn],  θ = C η,  q = C A η
-//!       |  …     1   0  |        | … |
+//!       |  0   1   0  …  0  |        | h1 |
+//!   A = |  0   0   1  …  0  |    B = | h2 |    C = [1 0 … 0],  θ = η1,  q = C A η = η2
+//!       |  …            1   |        | …  |
+//!       | -an  …  -a2  -a1  |        | hn |
 //! ```
 //!
-//! It is minimal when `N` and `D` have no common root. When `n < N` the
-//! last `N - n` states are padding: zero rows and columns, they stay exactly
-//! zero. `deg N <= n - 2` so that `C B = 0` and the pitch rate `q = C A η`
-//! has no direct feed-through from the elevator (model contract §4).
-//! Discretization is the exact zero-order hold, computed in f32 by
-//! [`crate::expm::zoh`].
+//! with `h1..hn` the first Markov parameters of `N/D` (`h1 = b1`,
+//! `hk = bk − Σ_{i<k} ai h(k−i)`). `deg N <= n - 2` makes `h1 = C B = 0`, so
+//! the pitch rate has no direct feed-through from the elevator (model
+//! contract §4) and is exactly the second state. The model contract allows
+//! any minimal realization; this one makes the autopilot's two
+//! measurements free (no `C η`, `C A η` products in the simulation loop).
+//! It is minimal when `N` and `D` have no common root. Every realization of
+//! the same `N/D` has the same Markov parameters `C Ad^k Bd`, which is how
+//! the tests compare it with the f64 reference's (scipy's `tf2ss`) form.
+//! When `n < N` the last `N - n` states are padding: zero rows and columns,
+//! they stay exactly zero. Discretization is the exact zero-order hold,
+//! computed in f32 by [`crate::expm::zoh`].
 
 use core::fmt;
 
@@ -254,20 +262,45 @@ impl<const N: usize> TransferFunction<N> {
             .unwrap_or(0.0)
     }
 
-    /// The continuous state matrices `(A, C)` of the canonical form.
-    pub fn realization(&self) -> (SMatrix<f32, N, N>, SVector<f32, N>) {
+    /// The continuous state-space matrices `(A, B, C)` of the observability
+    /// canonical form (module docs): `A` in 1/s, `B` in state per deg of
+    /// elevator per second, `C` the pitch row (a column vector `e1`).
+    pub fn realization(&self) -> (SMatrix<f32, N, N>, SVector<f32, N>, SVector<f32, N>) {
+        let n = self.order;
         let mut a = SMatrix::<f32, N, N>::zeros();
-        for (j, &aj) in self.den.iter().enumerate().take(self.order) {
-            if let Some(v) = a.get_mut((0, j)) {
-                *v = -aj;
-            }
-        }
-        for i in 1..self.order {
-            if let Some(v) = a.get_mut((i, i.saturating_sub(1))) {
+        for i in 1..n {
+            if let Some(v) = a.get_mut((i.saturating_sub(1), i)) {
                 *v = 1.0;
             }
         }
-        (a, SVector::from(self.num))
+        // Last row: -an … -a1.
+        let last = n.saturating_sub(1);
+        for (j, &aj) in self.den.iter().enumerate().take(n) {
+            if let Some(v) = a.get_mut((last, last.saturating_sub(j))) {
+                *v = -aj;
+            }
+        }
+        // Markov parameters: h_k = b_k − Σ_{i=1}^{k−1} a_i h_{k−i}.
+        let mut b = SVector::<f32, N>::zeros();
+        for k in 0..n {
+            let mut h = self.num.get(k).copied().unwrap_or(0.0);
+            for i in 0..k {
+                let ai = self.den.get(i).copied().unwrap_or(0.0);
+                let hk = b
+                    .get(k.saturating_sub(i).saturating_sub(1))
+                    .copied()
+                    .unwrap_or(0.0);
+                h -= ai * hk;
+            }
+            if let Some(v) = b.get_mut(k) {
+                *v = h;
+            }
+        }
+        let mut c = SVector::<f32, N>::zeros();
+        if let Some(v) = c.get_mut(0) {
+            *v = 1.0;
+        }
+        (a, b, c)
     }
 }
 
@@ -313,8 +346,8 @@ impl<const N: usize> Plant<N> {
         if !(sample_time.is_finite() && sample_time > 0.0) {
             return Err(PlantError::SampleTime);
         }
-        let (a, c) = tf.realization();
-        let (ad, bd) = expm::zoh(&a, sample_time).ok_or(PlantError::Discretization)?;
+        let (a, b, c) = tf.realization();
+        let (ad, bd) = expm::zoh(&a, &b, sample_time).ok_or(PlantError::Discretization)?;
         let ca = a.transpose() * c;
         Ok(Self {
             tf,
@@ -352,30 +385,42 @@ impl<const N: usize> Plant<N> {
         &self.bd
     }
 
-    /// Output row `C` (pitch, deg, per state), as a column vector.
+    /// Output row `C` (pitch, deg, per state), as a column vector: `e1`.
     pub fn c(&self) -> &SVector<f32, N> {
         &self.c
     }
 
-    /// `(C A)ᵀ`: pitch rate, deg/s, per state.
+    /// `(C A)ᵀ`: pitch rate, deg/s, per state: `e2`.
     pub fn ca(&self) -> &SVector<f32, N> {
         &self.ca
     }
 
-    /// Pitch `θ = C η`, deg.
-    #[inline]
+    /// Pitch `θ = C η = η1`, deg.
+    #[inline(always)]
     pub fn pitch(&self, eta: &SVector<f32, N>) -> f32 {
-        self.c.dot(eta)
+        eta.get(0).copied().unwrap_or(0.0)
     }
 
-    /// Pitch rate `q = C A η`, deg/s.
-    #[inline]
+    /// Pitch rate `q = C A η = η2`, deg/s.
+    #[inline(always)]
     pub fn pitch_rate(&self, eta: &SVector<f32, N>) -> f32 {
-        self.ca.dot(eta)
+        eta.get(1).copied().unwrap_or(0.0)
+    }
+
+    /// The pitch row of `K` state columns (tangents): `C m`, deg per column.
+    #[inline(always)]
+    pub(crate) fn pitch_of<const K: usize>(&self, m: &SMatrix<f32, N, K>) -> SVector<f32, K> {
+        SVector::from_fn(|k, _| m.get((0, k)).copied().unwrap_or(0.0))
+    }
+
+    /// The pitch-rate row of `K` state columns: `C A m`, deg/s per column.
+    #[inline(always)]
+    pub(crate) fn pitch_rate_of<const K: usize>(&self, m: &SMatrix<f32, N, K>) -> SVector<f32, K> {
+        SVector::from_fn(|k, _| m.get((1, k)).copied().unwrap_or(0.0))
     }
 
     /// One sample: `Ad η + Bd δ` with the elevator `δ` (deg) held.
-    #[inline]
+    #[inline(always)]
     pub fn step(&self, eta: &SVector<f32, N>, elevator: f32) -> SVector<f32, N> {
         self.ad * eta + self.bd * elevator
     }
@@ -416,8 +461,8 @@ mod tests {
         );
         // deg N = 1 = n - 2 is allowed: C B = 0 still.
         let tf = TransferFunction::<3>::pitch(&[1.0, -0.173], &den).unwrap();
-        let p = Plant::new(tf, 0.1).unwrap();
-        assert_eq!(p.c()[0], 0.0);
+        let (_, b, c) = tf.realization();
+        assert_eq!(c.dot(&b), 0.0);
         assert_eq!(
             TransferFunction::<2>::pitch(&[-0.173], &den),
             Err(PlantError::OrderTooHigh {
@@ -456,6 +501,32 @@ mod tests {
         assert_eq!(p.ad()[(3, 3)], 1.0);
         assert_eq!(p.bd()[2], 0.0);
         assert_eq!(p.ad()[(0, 2)], 0.0);
+    }
+
+    #[test]
+    fn realization_is_the_transfer_function() {
+        // C (sI − A)⁻¹ B = N(s)/D(s) at a few real s, for a plant with a
+        // numerator zero, padded into a larger capacity.
+        let num = [0.3_f32, -0.5];
+        let den = [1.0_f32, 2.0, 1.5, 0.4];
+        let tf = TransferFunction::<4>::pitch(&num, &den).unwrap();
+        let (a, b, c) = tf.realization();
+        for s in [0.25_f32, 1.0, 3.0] {
+            let m = SMatrix::<f32, 4, 4>::identity() * s - a;
+            let x = m.try_inverse().unwrap() * b;
+            let got = c.dot(&x);
+            let n = num[0] * s + num[1];
+            let d = ((den[0] * s + den[1]) * s + den[2]) * s + den[3];
+            assert!(
+                (got - n / d).abs() < 1e-5 * (n / d).abs(),
+                "{s}: {got} vs {}",
+                n / d
+            );
+        }
+        // θ = η1, q = η2, and no feed-through (C B = 0).
+        assert_eq!(c[0], 1.0);
+        assert_eq!((a.transpose() * c)[1], 1.0);
+        assert_eq!(c.dot(&b), 0.0);
     }
 
     #[test]

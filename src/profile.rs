@@ -184,7 +184,7 @@ impl<const S: usize> Profile<S> {
     /// The cursor makes the lookups of a simulation, whose `x` moves by a
     /// fraction of a sample spacing per step, O(1) instead of a search.
     /// Returns `None` outside the profile.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn locate(&self, cursor: &mut Cursor, x: Comp) -> Option<Point> {
         let xv = x.value();
         // Fast path: still in the cached segment (plain f32 compares; the
@@ -242,6 +242,32 @@ impl<const S: usize> Profile<S> {
     }
 }
 
+impl Cursor {
+    /// End `x_{i+1}` of the cached segment, m; `-inf` before the first
+    /// lookup.
+    #[inline(always)]
+    pub(crate) fn end(&self) -> f32 {
+        if self.valid {
+            self.x1
+        } else {
+            f32::NEG_INFINITY
+        }
+    }
+
+    /// The bottom at `x`, interpolated on the cached segment: for an `x`
+    /// the caller knows lies on it (see [`Profile::locate`]).
+    #[inline(always)]
+    pub(crate) fn point(&self, x: Comp) -> Point {
+        let offset = x.minus(self.x0);
+        Point {
+            depth: self.b0 + self.slope * offset,
+            base: self.b0,
+            offset,
+            slope: self.slope,
+        }
+    }
+}
+
 /// Cached segment of an incremental profile lookup.
 #[derive(Clone, Copy, Debug, Default)]
 pub(crate) struct Cursor {
@@ -271,7 +297,7 @@ impl Point {
     ///
     /// `base - d.hi` is exact when the two are within a factor of two, so
     /// the altitude keeps its absolute accuracy even 5 km down.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn altitude(&self, d: Comp) -> f32 {
         -d.minus(self.base) + self.slope * self.offset
     }

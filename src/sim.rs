@@ -26,7 +26,7 @@ use heapless::Vec;
 use nalgebra::SVector;
 
 use crate::autopilot::Command;
-use crate::num::{Comp, DEG, Sum};
+use crate::num::{Comp, DEG, Sum, max, min};
 use crate::profile::{Cursor, Point, Profile};
 use crate::vehicle::{Mission, Vehicle};
 
@@ -589,7 +589,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     }
 
     /// The one simulation loop; see the module docs.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn run<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
         &self,
         start: &VehicleState<N>,
@@ -629,7 +629,6 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         }
 
         let plant = self.vehicle.plant();
-        let ap = self.vehicle.autopilot();
         let ts = plant.sample_time();
         let step_len = self.vehicle.speed() * ts;
         // Even flying at 75° on average the line would be done by then.
@@ -658,7 +657,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
             };
             self.score(&prev, &cur, first, first, last, scores, sens)?;
         } else if let (Some(a), Some(s)) = (cur.at, scores.first_mut()) {
-            s.min_altitude = s.min_altitude.min(a.h);
+            s.min_altitude = min(s.min_altitude, a.h);
         }
 
         let mut track = first;
@@ -667,14 +666,19 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         let mut steps = 0_u32;
         // θ_k: computed once per step, as θ_{k+1} of the step before.
         let mut pitch = plant.pitch(&st.eta);
+        let mut rise = st.depth.diff(st.depth_prev);
+        let h_r = self.mission.reference_altitude();
+        let h_p = self.penalty_altitude;
         loop {
-            let pitch_rate = plant.pitch_rate(&st.eta);
+            // A sample whose step needs the general treatment: the end of
+            // the run, a waypoint switch, a new bottom segment, a sample
+            // not scored.
             if cur.past >= 0.0 {
                 observe(&Sample {
                     x: st.x(),
                     depth: st.depth(),
                     pitch,
-                    pitch_rate,
+                    pitch_rate: plant.pitch_rate(&st.eta),
                     reference: None,
                     command: None,
                 });
@@ -688,67 +692,87 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
             }
             let slot = track.saturating_sub(first);
             let r = *depths.get(slot).ok_or(SimError::TrackRange)?;
-            steps = steps.saturating_add(1);
-            if steps > max_steps {
-                return Err(SimError::StepLimit);
-            }
 
-            let e_d = -st.depth.minus(r);
-            let depth_rate = st.depth.diff(st.depth_prev) / ts;
-            let command = ap.cascade(
-                &mut st.depth_integral,
-                &mut st.pitch_integral,
-                e_d,
-                depth_rate,
-                pitch,
-                pitch_rate,
-            );
-            observe(&Sample {
-                x: st.x(),
-                depth: st.depth(),
-                pitch,
-                pitch_rate,
-                reference: Some((track, r)),
-                command: Some(command),
-            });
-            let eta = plant.step(&st.eta, command.elevator);
-            let pitch_next = plant.pitch(&eta);
-            let mean = 0.5 * (pitch + pitch_next) * DEG;
-            let (sin, cos) = crate::num::sin_cos(mean);
-            let dx = step_len * cos;
-            let dd = -step_len * sin;
-            // NaN fails `dx > 0` too.
-            if !(dx > 0.0 && dd.is_finite() && st.depth_integral.is_finite()) {
-                return Err(SimError::Diverged);
-            }
-            st.eta = eta;
-            pitch = pitch_next;
-            st.depth_prev = st.depth;
-            st.x_prev = st.x;
-            st.depth = st.depth.add(dd);
-            st.x = st.x.add(dx);
-            sens.step(
-                self.vehicle,
-                &StepLin {
-                    slot,
-                    command,
-                    sin,
-                    cos,
-                },
-            );
-            let prev = cur;
-            cur = self.geo(&mut cursor, st.x, st.depth, x_end)?;
-            match (prev.at, cur.at) {
-                // The common case: a segment inside the active track, both
-                // samples scored already; Δx and Δd are the step's exact
-                // increments.
-                (Some(a0), Some(a1)) if st.x.minus(track_end) <= 0.0 => {
-                    let s = scores.get_mut(slot).ok_or(SimError::ScoreBuffer)?;
-                    s.j.add(0.25 * dx * (a0.e * a0.e + a1.e * a1.e));
-                    if a0.p > 0.0 || a1.p > 0.0 {
-                        s.violation.add(0.25 * dx * (a0.p * a0.p + a1.p * a1.p));
+            // The fast path: from a scored sample inside the track, as long
+            // as each new sample lands short of `fast_limit` it lies on the
+            // active track, before the line's end and on the bottom segment
+            // the cursor holds, and the segment it ends is scored wholly
+            // into this track, with its running score kept in registers.
+            // The limit is a few ulps and a millimetre short of the next
+            // event, so that its plain f32 compare never decides a case the
+            // exact (compensated) tests would decide otherwise.
+            if let Some(mut a0) = cur.at
+                && st.x.minus(track_end) < 0.0
+            {
+                let event = min(track_end, cursor.end());
+                let fast_limit = event - (1e-3 + 4.0 * f32::EPSILON * libm::fabsf(event));
+                let score = scores.get_mut(slot).ok_or(SimError::ScoreBuffer)?;
+                let mut acc = *score;
+                let mut e2 = a0.e * a0.e;
+                let mut guard = if a0.p > 0.0 {
+                    f32::INFINITY
+                } else {
+                    max(acc.min_altitude, h_p)
+                };
+                let mut fast = false;
+                loop {
+                    steps = steps.saturating_add(1);
+                    if steps > max_steps {
+                        *score = acc;
+                        return Err(SimError::StepLimit);
                     }
-                    s.min_altitude = s.min_altitude.min(a0.h).min(a1.h);
+                    let (dx, dd) = match self.advance(
+                        &mut st,
+                        &mut pitch,
+                        &mut rise,
+                        r,
+                        track,
+                        slot,
+                        sens,
+                        &mut observe,
+                    ) {
+                        Ok(v) => v,
+                        Err(e) => {
+                            *score = acc;
+                            return Err(e);
+                        }
+                    };
+                    if !(st.x.value() < fast_limit) {
+                        break;
+                    }
+                    fast = true;
+                    // Δx and Δd are the step's exact increments; the new
+                    // sample is on the cursor's segment: no lookup.
+                    let p1 = cursor.point(st.x);
+                    let h = p1.altitude(st.depth);
+                    let e = h - h_r;
+                    let mut a1 = At {
+                        h,
+                        slope: p1.slope,
+                        e,
+                        p: 0.0,
+                    };
+                    let e2_next = e * e;
+                    acc.j.add(0.25 * dx * (e2 + e2_next));
+                    // One compare in the common case: a sample at or above
+                    // `guard` sets no new minimum and does not violate, and
+                    // `guard` is +inf after a violating sample, so that the
+                    // violation's next trapezoid is taken here too.
+                    if !(h >= guard) {
+                        let pen = h_p - h;
+                        a1.p = if pen > 0.0 { pen } else { 0.0 };
+                        if a0.p > 0.0 || a1.p > 0.0 {
+                            acc.violation.add(0.25 * dx * (a0.p * a0.p + a1.p * a1.p));
+                        }
+                        // The segment's first sample was counted as the
+                        // last one's end.
+                        acc.min_altitude = min(acc.min_altitude, h);
+                        guard = if a1.p > 0.0 {
+                            f32::INFINITY
+                        } else {
+                            max(acc.min_altitude, h_p)
+                        };
+                    }
                     sens.piece(
                         slot,
                         &PieceLin {
@@ -762,14 +786,44 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                             },
                             hi: End {
                                 at: EndAt::End { slope: a1.slope },
-                                e: a1.e,
+                                e,
                                 p: a1.p,
                             },
                         },
                     );
+                    e2 = e2_next;
+                    a0 = a1;
                 }
-                _ => self.score(&prev, &cur, track, first, last, scores, sens)?,
+                *score = acc;
+                if fast {
+                    // The sample before the one that left the fast path.
+                    cur = Geo {
+                        x: st.x_prev,
+                        d: st.depth_prev,
+                        at: Some(a0),
+                        past: -1.0,
+                    };
+                }
+            } else {
+                steps = steps.saturating_add(1);
+                if steps > max_steps {
+                    return Err(SimError::StepLimit);
+                }
+                self.advance(
+                    &mut st,
+                    &mut pitch,
+                    &mut rise,
+                    r,
+                    track,
+                    slot,
+                    sens,
+                    &mut observe,
+                )?;
             }
+            // The step just taken, the general way.
+            let prev = cur;
+            cur = self.geo(&mut cursor, st.x, st.depth, x_end)?;
+            self.score(&prev, &cur, track, first, last, scores, sens)?;
         }
         if scores.iter().any(|s| !s.min_altitude.is_finite()) {
             return Err(SimError::Diverged);
@@ -777,10 +831,91 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         Ok(st)
     }
 
+    /// One step of the loop (contract §7, steps 2–5) from `st`, whose pitch
+    /// `θ_k` is `pitch` and depth change `d_k − d_{k−1}` is `rise`, on
+    /// reference `r` of `track`: the cascade, the plant, the kinematics.
+    /// Updates `st`, `pitch` and `rise` to sample `k + 1`,
+    /// hands sample `k` to `observe` and the linearization to `sens`;
+    /// returns the increments `(Δx, Δd)`, m.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn advance<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
+        &self,
+        st: &mut VehicleState<N>,
+        pitch: &mut f32,
+        rise: &mut f32,
+        r: f32,
+        track: usize,
+        slot: usize,
+        sens: &mut Sn,
+        observe: &mut F,
+    ) -> Result<(f32, f32), SimError> {
+        let plant = self.vehicle.plant();
+        let ts = plant.sample_time();
+        let pitch_rate = plant.pitch_rate(&st.eta);
+        let e_d = -st.depth.minus(r);
+        // `d_k − d_{k−1}` is the last step's `Δd`: `depth` was `depth_prev`
+        // plus it, exactly to the rounding of the compensation term.
+        let depth_rate = *rise / ts;
+        let command = self.vehicle.autopilot().cascade(
+            &mut st.depth_integral,
+            &mut st.pitch_integral,
+            e_d,
+            depth_rate,
+            *pitch,
+            pitch_rate,
+        );
+        observe(&Sample {
+            x: st.x(),
+            depth: st.depth(),
+            pitch: *pitch,
+            pitch_rate,
+            reference: Some((track, r)),
+            command: Some(command),
+        });
+        let eta = plant.step(&st.eta, command.elevator);
+        let pitch_next = plant.pitch(&eta);
+        let mean = (*pitch + pitch_next) * (0.5 * DEG);
+        // A cruising vehicle's mean pitch is within ±45°: the short
+        // polynomials, whose results are finite with `cos > 0`. Beyond (or
+        // NaN, from a diverging loop), the checked general case.
+        let (sin, cos) = if libm::fabsf(mean) <= crate::num::SHORT {
+            crate::num::sin_cos_short(mean)
+        } else {
+            let (sin, cos) = crate::num::sin_cos(mean);
+            // NaN fails `cos > 0` too.
+            if !(cos > 0.0 && sin.is_finite()) {
+                return Err(SimError::Diverged);
+            }
+            (sin, cos)
+        };
+        // With `r`, `d` and `Δd` finite, `e_d` and so `I_d` are.
+        let step_len = self.vehicle.speed() * ts;
+        let dx = step_len * cos;
+        let dd = -step_len * sin;
+        st.eta = eta;
+        *pitch = pitch_next;
+        st.depth_prev = st.depth;
+        st.x_prev = st.x;
+        st.depth = st.depth.add(dd);
+        st.x = st.x.add(dx);
+        *rise = dd;
+        sens.step(
+            self.vehicle,
+            &StepLin {
+                slot,
+                command,
+                sin,
+                cos,
+            },
+        );
+        Ok((dx, dd))
+    }
+
     /// A sample's geometry; the bottom is looked up only where scoring
     /// needs it (`x <= x_end`), since the last sample may lie past the
     /// profile.
-    #[inline]
+    #[inline(always)]
     fn geo(&self, cursor: &mut Cursor, x: Comp, d: Comp, x_end: f32) -> Result<Geo, SimError> {
         let past = x.minus(x_end);
         let at = if past <= 0.0 {
@@ -805,7 +940,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     /// Scores segment `s0 → s1`, flown from track `track`, into every track
     /// of `first..last` it overlaps, clipping at the waypoints (§8).
     #[allow(clippy::too_many_arguments)]
-    #[inline]
+    #[inline(always)]
     fn score<Sn: Sensitivity<N>>(
         &self,
         s0: &Geo,
@@ -845,17 +980,19 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                 (EndAt::Start { .. }, _) => -s0.x.minus(b),
                 _ => b - a,
             };
+            let slot = t.saturating_sub(first);
+            let s = scores.get_mut(slot).ok_or(SimError::ScoreBuffer)?;
+            let (lo, h_lo) = lo;
+            let (hi, h_hi) = hi;
+            // The constraint holds at the end points too, even of a piece
+            // of zero length (a sample exactly on a waypoint).
+            s.min_altitude = min(min(s.min_altitude, h_lo), h_hi);
             if len > 0.0 {
-                let slot = t.saturating_sub(first);
-                let s = scores.get_mut(slot).ok_or(SimError::ScoreBuffer)?;
-                let (lo, h_lo) = lo;
-                let (hi, h_hi) = hi;
                 s.j.add(0.25 * len * (lo.e * lo.e + hi.e * hi.e));
                 // Most pieces keep clear of the penalty altitude.
                 if lo.p > 0.0 || hi.p > 0.0 {
                     s.violation.add(0.25 * len * (lo.p * lo.p + hi.p * hi.p));
                 }
-                s.min_altitude = s.min_altitude.min(h_lo).min(h_hi);
                 sens.piece(
                     slot,
                     &PieceLin {
@@ -876,7 +1013,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     }
 
     /// A piece end at one of the segment's samples, with its altitude.
-    #[inline]
+    #[inline(always)]
     fn sample_end(&self, s: &Geo, first: bool) -> Result<(End, f32), SimError> {
         let a = s.at.ok_or(SimError::OutOfProfile)?;
         let at = if first {
@@ -888,7 +1025,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     }
 
     /// A piece end clipped at waypoint `i`, depth interpolated in `x`.
-    #[inline]
+    #[inline(always)]
     fn clip_end(&self, s0: &Geo, dx: f32, dd: f32, i: usize) -> Result<(End, f32), SimError> {
         let c = *self
             .waypoints
@@ -901,12 +1038,15 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         Ok((self.end(EndAt::Clip { t }, h), h))
     }
 
-    #[inline]
+    #[inline(always)]
     fn end(&self, at: EndAt, h: f32) -> End {
         End {
             at,
             e: h - self.mission.reference_altitude(),
-            p: (self.penalty_altitude - h).max(0.0),
+            p: {
+                let p = self.penalty_altitude - h;
+                if p > 0.0 { p } else { 0.0 }
+            },
         }
     }
 }

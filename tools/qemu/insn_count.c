@@ -19,7 +19,10 @@
  * most instructions over the whole run, as `QEMU-PROFILE <count> <symbol>`
  * (mangled; pipe through `c++filt`): where the time goes. The profile
  * counts whole translation blocks, so it is approximate where a block ends
- * early (an exception); the marker counts are exact.
+ * early (an exception); the marker counts are exact. With `hot=N` it
+ * prints the N hottest translation blocks instead, as
+ * `QEMU-HOT <count> <address> <executions> x <size> <symbol>`: where inside
+ * a function the instructions go (tools/qemu/profile.sh --hot).
  *
  * Instructions, not cycles: QEMU does not model the Cortex-M pipeline,
  * flash wait states or FPU latencies. */
@@ -39,6 +42,7 @@ static int running;
 /* Profile: one record per translated block. */
 struct block {
     const char *sym;
+    uint64_t vaddr;
     uint64_t insns;
     uint64_t execs;
 };
@@ -46,6 +50,7 @@ static struct block **blocks;
 static size_t n_blocks, cap_blocks;
 static int profile_top; /* 0: no profile */
 static int per_block;   /* count=block: add a block's size when it starts */
+static int hot_top;     /* hot=N: the N hottest translation blocks */
 
 static void say(const char *s)
 {
@@ -136,6 +141,29 @@ static void print_profile(void)
     free(t);
 }
 
+static int by_block_count(const void *a, const void *b)
+{
+    const struct block *x = *(struct block *const *)a, *y = *(struct block *const *)b;
+    uint64_t u = x->insns * x->execs, v = y->insns * y->execs;
+    return u < v ? 1 : u > v ? -1 : 0;
+}
+
+/* The hottest blocks, by start address: where inside a function the
+ * instructions go (look the addresses up in `llvm-objdump -d`). */
+static void print_hot(void)
+{
+    char line[512];
+    qsort(blocks, n_blocks, sizeof *blocks, by_block_count);
+    for (size_t i = 0; i < n_blocks && i < (size_t)hot_top; i++) {
+        const struct block *b = blocks[i];
+        snprintf(line, sizeof line, "QEMU-HOT %llu 0x%llx %llu x %llu %s\n",
+                 (unsigned long long)(b->insns * b->execs), (unsigned long long)b->vaddr,
+                 (unsigned long long)b->execs, (unsigned long long)b->insns,
+                 b->sym ? b->sym : "?");
+        say(line);
+    }
+}
+
 static int is(const char *sym, const char *name)
 {
     return sym != NULL && strcmp(sym, name) == 0;
@@ -155,10 +183,11 @@ static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
             qemu_plugin_register_vcpu_tb_exec_cb(tb, on_stop, QEMU_PLUGIN_CB_NO_REGS, NULL);
         }
     }
-    if (profile_top > 0 && n > 0) {
+    if ((profile_top > 0 || hot_top > 0) && n > 0) {
         struct block *b = calloc(1, sizeof *b);
         if (b != NULL && (n_blocks < cap_blocks || grow())) {
             b->sym = qemu_plugin_insn_symbol(qemu_plugin_tb_get_insn(tb, 0));
+            b->vaddr = qemu_plugin_tb_vaddr(tb);
             b->insns = n;
             blocks[n_blocks++] = b;
             qemu_plugin_register_vcpu_tb_exec_inline(tb, QEMU_PLUGIN_INLINE_ADD_U64, &b->execs, 1);
@@ -184,6 +213,9 @@ static void on_end(qemu_plugin_id_t id, void *udata)
     if (profile_top > 0) {
         print_profile();
     }
+    if (hot_top > 0) {
+        print_hot();
+    }
 }
 
 QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_t *info, int argc,
@@ -193,6 +225,8 @@ QEMU_PLUGIN_EXPORT int qemu_plugin_install(qemu_plugin_id_t id, const qemu_info_
     for (int i = 0; i < argc; i++) {
         if (strncmp(argv[i], "profile=", 8) == 0) {
             profile_top = atoi(argv[i] + 8);
+        } else if (strncmp(argv[i], "hot=", 4) == 0) {
+            hot_top = atoi(argv[i] + 4);
         } else if (strcmp(argv[i], "count=block") == 0) {
             per_block = 1;
         }

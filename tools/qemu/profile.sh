@@ -4,11 +4,17 @@
 # functions by instructions executed over the whole run, demangled.
 #
 #   tools/qemu/profile.sh target/thumbv7em-none-eabihf/release/examples/qemu_bench [TOP]
+#   tools/qemu/profile.sh --hot ELF [TOP]   # the hottest blocks, by address
 #
 # Machine as tools/qemu/run.sh ($QEMU_MACHINE, lm3s6965evb for thumbv7m).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-elf=${1:?usage: profile.sh ELF [TOP]}
+mode=profile
+if [ "${1:-}" = --hot ]; then
+  mode=hot
+  shift
+fi
+elf=${1:?usage: profile.sh [--hot] ELF [TOP]}
 top=${2:-25}
 case "$elf" in
   */thumbv7m-none-eabi/*) machine=${QEMU_MACHINE:-lm3s6965evb} ;;
@@ -20,7 +26,7 @@ esac
 plugin=$("$here/build_plugin.sh")
 timeout --foreground "${QEMU_TIMEOUT:-600}" qemu-system-arm -machine "$machine" -cpu "$cpu" \
   -nographic -monitor none -serial none -semihosting-config enable=on,target=native \
-  -kernel "$elf" -plugin "$plugin,profile=$top" |
-  grep -a -E '^QEMU-(PROFILE|TOTAL) ' |
+  -kernel "$elf" -plugin "$plugin,$mode=$top" |
+  grep -a -E '^QEMU-(PROFILE|HOT|TOTAL) ' |
   awk '{ s = $3; for (i = 4; i <= NF; i++) s = s " " $i; printf "%14s  %s\n", ($1 == "QEMU-TOTAL" ? $2 " total" : $2), s }' |
   c++filt
