@@ -269,8 +269,8 @@ impl Autopilot {
         if pitch_integrating {
             *pitch_integral += self.sample_time * e_t;
         }
-        let pitch_ref_linear = pitch_ref == v;
-        let elevator_linear = elevator == w;
+        let pitch_ref_linear = libm::fabsf(v) <= self.cfg.pitch_limit;
+        let elevator_linear = libm::fabsf(w) <= self.cfg.elevator_limit;
         Command {
             pitch_ref,
             elevator,

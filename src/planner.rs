@@ -26,28 +26,44 @@
 //! gives a different flight, and the optimizer is never started on the
 //! plateau.
 //!
-//! **Starting point.** A coarse scan of `scan_points` depths over the box,
+//! **Starting point.** A coarse scan of `scan_points` depths over the box
+//! (`track_scan_points` for a constrained single track),
 //! track by track from the state the best of the previous track leaves:
 //! the search starts in the best basin found, never on a plateau that is
 //! not the best scanned value. In horizon mode later calls start from the
 //! previous call's plan, and only the newly visible track is scanned.
 //!
-//! **Constraint.** `h >= h_a` enters the optimization as a quadratic
-//! penalty: `Φ = Σ J + μ Σ V` with `V = ½ ∫ max(0, h_a + m_p − h)² dx`
+//! **Constraint, one track** (track-wise mode, and the last track of a
+//! horizon). The scan also gives each scanned depth's minimum altitude.
+//! When the scan's best depth is unsafe, or safe but with its parabola
+//! pointing to an unsafe neighbour, the optimum of `J` lies beyond the safe
+//! set, and the constrained optimum on its boundary next to it: a regula
+//! falsi (Illinois) search on the minimum altitude between the nearest
+//! safe and unsafe scanned depths finds it from the safe side in a few
+//! plain flights, and a finite difference of `J` there (the search's
+//! previous safe depth, or one more flight) confirms that `J` does not
+//! decrease into the safe set; if it does, BFGS optimizes from there. When
+//! no scanned depth is safe the track is [`PlanStatus::Infeasible`] and the
+//! safest scanned depth is returned. Otherwise BFGS (without a penalty)
+//! optimizes from the scan's parabola vertex, and an unsafe optimum falls
+//! back to the boundary by the same search ([`PlanStatus::SafeFallback`]).
+//!
+//! **Constraint, a horizon.** `h >= h_a` enters the optimization as a
+//! quadratic penalty: `Φ = Σ J + μ Σ V` with `V = ½ ∫ max(0, h_a + m_p − h)² dx`
 //! (the violation of [`crate::TrackScore`], taken against `h_a` plus the
 //! penalty margin `m_p`), whose exact gradient comes from the same tangent
 //! pass. `J` ranges from 1e2 to 1e8 m³ between a shallow bay and a canyon
 //! wall, so no single `μ` fits: the sequential penalty method (N&W §17.1)
 //! re-solves from the last optimum with `μ` a hundred times larger while
-//! that optimum still violates, for at most `penalty_stages` stages (one
-//! when a single track is optimized: the bisection below then finds the
-//! safe boundary exactly). Then the committed depth is **verified by simulation**: it is
-//! reported safe only when the track's minimum altitude is at least
+//! that optimum still violates, for at most `penalty_stages` stages.
+//!
+//! **Verification.** The committed depth is **verified by simulation**: it
+//! is reported safe only when the track's minimum altitude is at least
 //! `h_a + m_s` (the safety margin, covering f32 vs f64 differences in
 //! altitude). If not, the planner looks for the safe depth closest to the
-//! optimum (among the scanned depths, then by bisection to the safe-set
-//! boundary) and returns it flagged [`PlanStatus::SafeFallback`]; if no
-//! depth in the box is safe, it returns the safest depth it found, flagged
+//! optimum (among the scanned depths, then by the boundary search) and
+//! returns it flagged [`PlanStatus::SafeFallback`]; if no depth in the box
+//! is safe, it returns the safest depth it found, flagged
 //! [`PlanStatus::Infeasible`] with its predicted minimum altitude.
 //! With `constrained = false` (the paper's bare objective) there is no
 //! penalty and no fallback; safety is still verified and reported.
@@ -126,10 +142,20 @@ pub struct PlannerConfig {
     /// cases, so 2 mm covers them five times over; a wider margin costs `J`
     /// measurably where `h_r` is a few metres.
     pub safety_margin: f32,
-    /// Depths scanned per track for the starting point, ≥ 2. Default 9.
+    /// Depths scanned per track for the starting point, ≥ 2, in horizon
+    /// mode and for an unconstrained solve, where the scan alone keeps the
+    /// optimizer out of a worse basin. Default 9.
     pub scan_points: u32,
-    /// Bisection steps towards the safe-set boundary in a fallback.
-    /// Default 16 (a 50 m bracket to under a millimetre).
+    /// Depths scanned for a constrained single-track solve (track-wise
+    /// mode, the last track of a horizon), ≥ 2. Default 5: there the scan
+    /// is most of a solve's flights, and the boundary search, not the
+    /// optimizer, places most answers; the independent brute-force check
+    /// (`tools/reference/check_planner.py`) finds them within 0.5 % of the
+    /// best safe `J` on every shared profile.
+    pub track_scan_points: u32,
+    /// Most flights of the boundary search (regula falsi, Illinois) towards
+    /// the safe-set boundary. Default 16 (bisection alone would bring a
+    /// 50 m bracket under a millimetre); it usually stops after 2 to 4.
     pub bisection_steps: u32,
 }
 
@@ -147,6 +173,7 @@ impl Default for PlannerConfig {
             penalty_margin: 0.25,
             safety_margin: 0.002,
             scan_points: 9,
+            track_scan_points: 5,
             bisection_steps: 16,
         }
     }
@@ -177,6 +204,9 @@ impl PlannerConfig {
         }
         if self.scan_points < 2 || self.scan_points > MAX_SCAN {
             return Err("scan_points");
+        }
+        if self.track_scan_points < 2 || self.track_scan_points > MAX_SCAN {
+            return Err("track_scan_points");
         }
         Ok(())
     }
@@ -403,6 +433,135 @@ impl<const K: usize> Planner<K> {
             )?;
         }
 
+        // One track, constrained, scanned. When the scan says the optimum of
+        // `J` lies outside the safe set (its best depth is unsafe, or it is
+        // safe but the parabola through it and its neighbours peaks in an
+        // unsafe neighbour's direction), the constrained optimum is on the
+        // safe set's boundary next to it: find that boundary directly
+        // (`boundary`, a few plain flights), then check with one exact
+        // gradient there that `J` does not decrease into the safe set; only
+        // if it does is there an interior optimum, for the optimizer to
+        // find from there. With no scanned depth safe, the track is
+        // infeasible. A single track is then optimized without the
+        // penalty: the verification and this boundary search enforce the
+        // constraint exactly.
+        let h_safe = sc.mission().min_altitude() + self.cfg.safety_margin;
+        let single = h == 1 && self.cfg.constrained && from == 0 && scan.len > 0;
+        let mut mu = mu;
+        if single {
+            mu = 0.0;
+            let best = scan
+                .entries()
+                .filter(|e| e.1.is_finite())
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            let vertex = z0.get(0).copied().unwrap_or(0.0);
+            // The scanned neighbour of `from` in the direction of `to`.
+            let neighbour = |from: f32, to: f32| {
+                scan.entries()
+                    .filter(|e| (e.0 - from) * (to - from) > 0.0)
+                    .min_by(|a, b| libm::fabsf(a.0 - from).total_cmp(&libm::fabsf(b.0 - from)))
+            };
+            // A bracket (safe end, unsafe end) of the boundary when the scan
+            // puts the optimum beyond it; `infeasible` when nothing scanned
+            // is safe.
+            let mut bracket: Option<(End, End)> = None;
+            let mut infeasible = false;
+            if let Some((z_best, _, alt_best)) = best {
+                if alt_best < h_safe {
+                    let safe = scan.entries().filter(|e| e.2 >= h_safe).min_by(|a, b| {
+                        libm::fabsf(a.0 - z_best).total_cmp(&libm::fabsf(b.0 - z_best))
+                    });
+                    match safe {
+                        Some(sf) => {
+                            let unsafe_end = neighbour(sf.0, z_best)
+                                .map_or((z_best, Some(alt_best)), |e| (e.0, Some(e.2)));
+                            bracket = Some(((sf.0, Some(sf.2)), unsafe_end));
+                        }
+                        None => infeasible = true,
+                    }
+                } else if let Some(n) = neighbour(z_best, vertex)
+                    && n.2 < h_safe
+                    && libm::fabsf(vertex - z_best) > 0.0
+                {
+                    bracket = Some(((z_best, Some(alt_best)), (n.0, Some(n.2))));
+                }
+            }
+            let mut found: Option<(f32, TrackScore, VehicleState<N>, PlanStatus)> = None;
+            if infeasible {
+                // The safest scanned depth.
+                let z = scan
+                    .iter()
+                    .max_by(|a, b| a.1.total_cmp(&b.1))
+                    .map_or(vertex, |e| e.0);
+                let (score, next) = self.fly(sc, state, track, z, &mut evaluations)?;
+                found = Some((z, score, next, PlanStatus::Infeasible));
+            } else if let Some((good, bad)) = bracket {
+                let b = self.boundary(sc, state, track, good, bad, h_safe, &mut evaluations)?;
+                let (z_b, score, next) = (b.depth, b.score, b.next);
+                // Does `J` decrease from the boundary into the safe set? A
+                // finite difference towards the safe side: the boundary
+                // search's previous safe depth when it is within
+                // `CHECK_STEP` (no extra flight), else one flight there.
+                let inward = good.0 - z_b;
+                let step = CHECK_STEP.min(libm::fabsf(inward)).copysign(inward);
+                let near = b.inner.filter(|p| libm::fabsf(p.0 - z_b) <= CHECK_STEP);
+                let (z_in, j_in) = match near {
+                    Some(p) => p,
+                    None => {
+                        let z = z_b + step;
+                        let j = self
+                            .fly(sc, state, track, z, &mut evaluations)
+                            .map_or(f32::INFINITY, |(s, _)| s.j());
+                        (z, j)
+                    }
+                };
+                let slope = (j_in - score.j()) / (z_in - z_b);
+                if slope * inward < 0.0 {
+                    // An interior optimum: optimize from the boundary.
+                    if let Some(slot) = z0.get_mut(0) {
+                        *slot = z_b;
+                    }
+                    curvature = SVector::zeros();
+                } else {
+                    found = Some((z_b, score, next, PlanStatus::SafeFallback));
+                }
+            }
+            if let Some((depth, score, next, status)) = found {
+                let mut history = Vec::new();
+                let _ = history.push(score.j());
+                let mut horizon = [0.0_f32; K];
+                if let Some(first) = horizon.first_mut() {
+                    *first = depth;
+                }
+                self.warm = None;
+                crate::log::debug!(
+                    "plan track {=usize}: depth {=f32} m, {=str} from the scan, J {=f32} m3, min altitude {=f32} m, {=u32} evaluations",
+                    track,
+                    depth,
+                    status.as_str(),
+                    score.j(),
+                    score.min_altitude(),
+                    evaluations
+                );
+                return Ok(Plan {
+                    depth,
+                    status,
+                    safe: score.min_altitude() >= h_safe,
+                    j: score.j(),
+                    rms: score.rms(),
+                    min_altitude: score.min_altitude(),
+                    objective: score.j(),
+                    iterations: 0,
+                    evaluations,
+                    grad_norm: 0.0,
+                    history,
+                    horizon,
+                    horizon_len: h,
+                    next_state: next,
+                });
+            }
+        }
+
         // Optimize, in penalty stages.
         let mut obj = PlanObjective {
             sc: &penalized,
@@ -521,7 +680,6 @@ impl<const K: usize> Planner<K> {
             Some((z, s, n)) if z.to_bits() == z_opt.to_bits() => (s, n),
             _ => self.fly(sc, state, track, z_opt, &mut evaluations)?,
         };
-        let h_safe = sc.mission().min_altitude() + self.cfg.safety_margin;
         let verified = score.min_altitude() >= h_safe;
         if self.cfg.constrained && !verified {
             let lo = bounds.lo.get(0).copied().unwrap_or(depth);
@@ -530,7 +688,7 @@ impl<const K: usize> Planner<K> {
                 sc,
                 state,
                 track,
-                z_opt,
+                (z_opt, Some(score.min_altitude())),
                 lo,
                 hi,
                 h_safe,
@@ -677,7 +835,11 @@ impl<const K: usize> Planner<K> {
                 bounds.lo.get(j).copied().unwrap_or(0.0),
                 bounds.hi.get(j).copied().unwrap_or(0.0),
             );
-            let n = self.cfg.scan_points;
+            let n = if h == 1 && self.cfg.constrained {
+                self.cfg.track_scan_points
+            } else {
+                self.cfg.scan_points
+            };
             let mut phis = [f32::INFINITY; MAX_SCAN as usize];
             // Whether the penalty acts at a scanned depth: there the
             // objective has a kink and a parabola says nothing.
@@ -689,7 +851,7 @@ impl<const K: usize> Planner<K> {
                     continue;
                 };
                 if j == 0 {
-                    log.push(z, s.min_altitude());
+                    log.push(z, &s);
                 }
                 let phi = s.j() + mu * s.violation();
                 let i = k as usize;
@@ -754,7 +916,7 @@ impl<const K: usize> Planner<K> {
         sc: &Scenario<'_, N, S, W>,
         state: &VehicleState<N>,
         track: usize,
-        z_opt: f32,
+        (z_opt, alt_opt): (f32, Option<f32>),
         lo: f32,
         hi: f32,
         h_safe: f32,
@@ -766,7 +928,7 @@ impl<const K: usize> Planner<K> {
             for k in 0..n {
                 let z = grid(lo, hi, k, n);
                 if let Ok((s, _)) = self.fly(sc, state, track, z, evaluations) {
-                    log.push(z, s.min_altitude());
+                    log.push(z, &s);
                 }
             }
         }
@@ -775,26 +937,21 @@ impl<const K: usize> Planner<K> {
             .filter(|&(_, alt)| alt >= h_safe)
             .min_by(|a, b| libm::fabsf(a.0 - z_opt).total_cmp(&libm::fabsf(b.0 - z_opt)));
         match nearest_safe {
-            Some((z_safe, _)) => {
-                // Bisection on [unsafe z_opt, safe z_safe] to the boundary.
-                let (mut bad, mut good) = (z_opt, z_safe);
-                for _ in 0..self.cfg.bisection_steps {
-                    let mid = 0.5 * (bad + good);
-                    let safe = self
-                        .fly(sc, state, track, mid, evaluations)
-                        .is_ok_and(|(s, _)| s.min_altitude() >= h_safe);
-                    if safe {
-                        good = mid;
-                    } else {
-                        bad = mid;
-                    }
-                }
-                let (score, next) = self.fly(sc, state, track, good, evaluations)?;
+            Some((z_safe, alt_safe)) => {
+                let b = self.boundary(
+                    sc,
+                    state,
+                    track,
+                    (z_safe, Some(alt_safe)),
+                    (z_opt, alt_opt),
+                    h_safe,
+                    evaluations,
+                )?;
                 Ok(Fallback {
-                    depth: good,
-                    score,
-                    next,
-                    safe: score.min_altitude() >= h_safe,
+                    depth: b.depth,
+                    score: b.score,
+                    next: b.next,
+                    safe: b.score.min_altitude() >= h_safe,
                 })
             }
             None => {
@@ -814,6 +971,123 @@ impl<const K: usize> Planner<K> {
     }
 }
 
+impl<const K: usize> Planner<K> {
+    /// The safe-set boundary between a safe depth `good` (its flight, when
+    /// known) and an unsafe one `bad`, from the safe side: the Illinois
+    /// variant of regula falsi on `g(z) = min altitude − h_safe`, which is
+    /// close to linear in `z` near the boundary, so that a few flights
+    /// bracket it to a millimetre where bisection needs sixteen. Stops when
+    /// the safe end is within `BOUNDARY_ALTITUDE` of `h_safe`, the bracket
+    /// is under `BOUNDARY_DEPTH`, or after `bisection_steps` flights.
+    /// Returns the safe end with its flight.
+    #[allow(clippy::too_many_arguments)]
+    fn boundary<const N: usize, const S: usize, const W: usize>(
+        &self,
+        sc: &Scenario<'_, N, S, W>,
+        state: &VehicleState<N>,
+        track: usize,
+        (good, good_alt): (f32, Option<f32>),
+        (bad, bad_alt): (f32, Option<f32>),
+        h_safe: f32,
+        evaluations: &mut u32,
+    ) -> Result<Boundary<N>, PlanError> {
+        // Each end's minimum altitude, flown unless the caller knows it.
+        let (mut good, mut flight) = (good, None);
+        let mut g_good = match good_alt {
+            Some(a) => a - h_safe,
+            None => {
+                let f = self.fly(sc, state, track, good, evaluations)?;
+                flight = Some(f);
+                f.0.min_altitude() - h_safe
+            }
+        };
+        let mut bad = bad;
+        let mut inner = None;
+        let mut g_bad = match bad_alt {
+            Some(a) => a - h_safe,
+            None => match self.fly(sc, state, track, bad, evaluations) {
+                Ok((s, _)) => s.min_altitude() - h_safe,
+                Err(_) => -1.0,
+            },
+        };
+        // Which end the last two steps kept (Illinois halves its value).
+        let mut kept_good = false;
+        let mut kept_bad = false;
+        for _ in 0..self.cfg.bisection_steps {
+            if g_good <= BOUNDARY_ALTITUDE || libm::fabsf(good - bad) <= BOUNDARY_DEPTH {
+                break;
+            }
+            // Regula falsi, kept inside the middle 98 % of the bracket.
+            let t = if g_good > 0.0 && g_bad < 0.0 && (g_good - g_bad).is_finite() {
+                (g_good / (g_good - g_bad)).clamp(0.01, 0.99)
+            } else {
+                0.5
+            };
+            let mid = good + t * (bad - good);
+            match self.fly(sc, state, track, mid, evaluations) {
+                Ok((s, n)) if s.min_altitude() >= h_safe => {
+                    if let Some((f, _)) = flight {
+                        inner = Some((good, f.j()));
+                    }
+                    good = mid;
+                    g_good = s.min_altitude() - h_safe;
+                    flight = Some((s, n));
+                    if kept_bad {
+                        g_bad *= 0.5;
+                    }
+                    kept_bad = true;
+                    kept_good = false;
+                }
+                r => {
+                    bad = mid;
+                    g_bad = r.map_or(-1.0, |(s, _)| s.min_altitude() - h_safe);
+                    if kept_good {
+                        g_good *= 0.5;
+                    }
+                    kept_good = true;
+                    kept_bad = false;
+                }
+            }
+        }
+        let (score, next) = match flight {
+            Some(f) => f,
+            None => self.fly(sc, state, track, good, evaluations)?,
+        };
+        Ok(Boundary {
+            depth: good,
+            score,
+            next,
+            inner,
+        })
+    }
+}
+
+/// One end of a boundary bracket: a depth (m) and its minimum altitude
+/// (m) when known.
+type End = (f32, Option<f32>);
+
+/// What [`Planner::boundary`] found.
+struct Boundary<const N: usize> {
+    /// The safe end, m, its score and end state.
+    depth: f32,
+    score: TrackScore,
+    next: VehicleState<N>,
+    /// The safe end before it, with its `J` (m, m³), if it moved.
+    inner: Option<(f32, f32)>,
+}
+
+/// The boundary search stops when the safe end is within this much of the
+/// certified altitude `h_a + m_s`, m: 2 cm of depth move the `J` of a
+/// track by far less than the optimizer's tolerance.
+const BOUNDARY_ALTITUDE: f32 = 0.02;
+
+/// The finite-difference step, m, that checks a boundary optimum (`J` must
+/// not decrease into the safe set).
+const CHECK_STEP: f32 = 2.0;
+
+/// ... or when the bracket is this narrow, m (see `BOUNDARY_ALTITUDE`).
+const BOUNDARY_DEPTH: f32 = 1e-3;
+
 /// Point `k` of `n >= 2` evenly spaced over `[lo, hi]`.
 fn grid(lo: f32, hi: f32, k: u32, n: u32) -> f32 {
     lo + (hi - lo) * (k as f32) / (n.saturating_sub(1).max(1) as f32)
@@ -826,9 +1100,11 @@ struct Fallback<const N: usize> {
     safe: bool,
 }
 
-/// Depths tried on the committed track and their minimum altitudes.
+/// Depths tried on the committed track, with their `J` and minimum
+/// altitudes.
 struct ScanLog {
     z: [f32; MAX_SCAN as usize],
+    j: [f32; MAX_SCAN as usize],
     alt: [f32; MAX_SCAN as usize],
     len: usize,
 }
@@ -837,6 +1113,7 @@ impl Default for ScanLog {
     fn default() -> Self {
         Self {
             z: [0.0; MAX_SCAN as usize],
+            j: [0.0; MAX_SCAN as usize],
             alt: [0.0; MAX_SCAN as usize],
             len: 0,
         }
@@ -844,19 +1121,36 @@ impl Default for ScanLog {
 }
 
 impl ScanLog {
-    fn push(&mut self, z: f32, alt: f32) {
-        if let (Some(zs), Some(a)) = (self.z.get_mut(self.len), self.alt.get_mut(self.len)) {
+    fn push(&mut self, z: f32, s: &TrackScore) {
+        if let (Some(zs), Some(js), Some(a)) = (
+            self.z.get_mut(self.len),
+            self.j.get_mut(self.len),
+            self.alt.get_mut(self.len),
+        ) {
             *zs = z;
-            *a = alt;
+            *js = s.j();
+            *a = s.min_altitude();
             self.len = self.len.saturating_add(1);
         }
     }
 
+    /// `(z, alt)` of each entry.
     fn iter(&self) -> impl Iterator<Item = (f32, f32)> + '_ {
         self.z
             .iter()
             .copied()
             .zip(self.alt.iter().copied())
+            .take(self.len)
+    }
+
+    /// `(z, J, alt)` of each entry.
+    fn entries(&self) -> impl Iterator<Item = (f32, f32, f32)> + '_ {
+        self.z
+            .iter()
+            .copied()
+            .zip(self.j.iter().copied())
+            .zip(self.alt.iter().copied())
+            .map(|((z, j), a)| (z, j, a))
             .take(self.len)
     }
 }

@@ -737,7 +737,8 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                             return Err(e);
                         }
                     };
-                    if !(st.x.value() < fast_limit) {
+                    // (NaN leaves the fast path too.)
+                    if st.x.value().partial_cmp(&fast_limit) != Some(core::cmp::Ordering::Less) {
                         break;
                     }
                     fast = true;
@@ -758,7 +759,9 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                     // `guard` sets no new minimum and does not violate, and
                     // `guard` is +inf after a violating sample, so that the
                     // violation's next trapezoid is taken here too.
-                    if !(h >= guard) {
+                    if h.partial_cmp(&guard)
+                        .is_none_or(|o| o == core::cmp::Ordering::Less)
+                    {
                         let pen = h_p - h;
                         a1.p = if pen > 0.0 { pen } else { 0.0 };
                         if a0.p > 0.0 || a1.p > 0.0 {
