@@ -450,115 +450,17 @@ impl<const K: usize> Planner<K> {
         let mut mu = mu;
         if single {
             mu = 0.0;
-            let best = scan
-                .entries()
-                .filter(|e| e.1.is_finite())
-                .min_by(|a, b| a.1.total_cmp(&b.1));
-            let vertex = z0.get(0).copied().unwrap_or(0.0);
-            // The scanned neighbour of `from` in the direction of `to`.
-            let neighbour = |from: f32, to: f32| {
-                scan.entries()
-                    .filter(|e| (e.0 - from) * (to - from) > 0.0)
-                    .min_by(|a, b| libm::fabsf(a.0 - from).total_cmp(&libm::fabsf(b.0 - from)))
-            };
-            // A bracket (safe end, unsafe end) of the boundary when the scan
-            // puts the optimum beyond it; `infeasible` when nothing scanned
-            // is safe.
-            let mut bracket: Option<(End, End)> = None;
-            let mut infeasible = false;
-            if let Some((z_best, _, alt_best)) = best {
-                if alt_best < h_safe {
-                    let safe = scan.entries().filter(|e| e.2 >= h_safe).min_by(|a, b| {
-                        libm::fabsf(a.0 - z_best).total_cmp(&libm::fabsf(b.0 - z_best))
-                    });
-                    match safe {
-                        Some(sf) => {
-                            let unsafe_end = neighbour(sf.0, z_best)
-                                .map_or((z_best, Some(alt_best)), |e| (e.0, Some(e.2)));
-                            bracket = Some(((sf.0, Some(sf.2)), unsafe_end));
-                        }
-                        None => infeasible = true,
-                    }
-                } else if let Some(n) = neighbour(z_best, vertex)
-                    && n.2 < h_safe
-                    && libm::fabsf(vertex - z_best) > 0.0
-                {
-                    bracket = Some(((z_best, Some(alt_best)), (n.0, Some(n.2))));
-                }
-            }
-            let mut found: Option<(f32, TrackScore, VehicleState<N>, PlanStatus)> = None;
-            if infeasible {
-                // The safest scanned depth.
-                let z = scan
-                    .iter()
-                    .max_by(|a, b| a.1.total_cmp(&b.1))
-                    .map_or(vertex, |e| e.0);
-                let (score, next) = self.fly(sc, state, track, z, &mut evaluations)?;
-                found = Some((z, score, next, PlanStatus::Infeasible));
-            } else if let Some((good, bad)) = bracket {
-                let b = self.boundary(sc, state, track, good, bad, h_safe, &mut evaluations)?;
-                let (z_b, score, next) = (b.depth, b.score, b.next);
-                // Does `J` decrease from the boundary into the safe set? A
-                // finite difference towards the safe side: the boundary
-                // search's previous safe depth when it is within
-                // `CHECK_STEP` (no extra flight), else one flight there.
-                let inward = good.0 - z_b;
-                let step = CHECK_STEP.min(libm::fabsf(inward)).copysign(inward);
-                let near = b.inner.filter(|p| libm::fabsf(p.0 - z_b) <= CHECK_STEP);
-                let (z_in, j_in) = match near {
-                    Some(p) => p,
-                    None => {
-                        let z = z_b + step;
-                        let j = self
-                            .fly(sc, state, track, z, &mut evaluations)
-                            .map_or(f32::INFINITY, |(s, _)| s.j());
-                        (z, j)
-                    }
-                };
-                let slope = (j_in - score.j()) / (z_in - z_b);
-                if slope * inward < 0.0 {
-                    // An interior optimum: optimize from the boundary.
-                    if let Some(slot) = z0.get_mut(0) {
-                        *slot = z_b;
-                    }
-                    curvature = SVector::zeros();
-                } else {
-                    found = Some((z_b, score, next, PlanStatus::SafeFallback));
-                }
-            }
-            if let Some((depth, score, next, status)) = found {
-                let mut history = Vec::new();
-                let _ = history.push(score.j());
-                let mut horizon = [0.0_f32; K];
-                if let Some(first) = horizon.first_mut() {
-                    *first = depth;
-                }
-                self.warm = None;
-                crate::log::debug!(
-                    "plan track {=usize}: depth {=f32} m, {=str} from the scan, J {=f32} m3, min altitude {=f32} m, {=u32} evaluations",
-                    track,
-                    depth,
-                    status.as_str(),
-                    score.j(),
-                    score.min_altitude(),
-                    evaluations
-                );
-                return Ok(Plan {
-                    depth,
-                    status,
-                    safe: score.min_altitude() >= h_safe,
-                    j: score.j(),
-                    rms: score.rms(),
-                    min_altitude: score.min_altitude(),
-                    objective: score.j(),
-                    iterations: 0,
-                    evaluations,
-                    grad_norm: 0.0,
-                    history,
-                    horizon,
-                    horizon_len: h,
-                    next_state: next,
-                });
+            if let Some(plan) = self.single_start(
+                sc,
+                state,
+                track,
+                &scan,
+                h_safe,
+                &mut z0,
+                &mut curvature,
+                &mut evaluations,
+            )? {
+                return Ok(plan);
             }
         }
 
@@ -572,6 +474,9 @@ impl<const K: usize> Planner<K> {
             evaluations: 0,
             last_violation: 0.0,
             last_flight: None,
+            guard: single.then_some(h_safe),
+            tripped: None,
+            best_safe: None,
         };
         // A warm start is already close: a shorter first step.
         let first_step = if warm.is_some() {
@@ -580,7 +485,33 @@ impl<const K: usize> Planner<K> {
             self.cfg.bfgs.first_step
         };
         let cap = self.cfg.bfgs.max_iterations;
-        let mut outcome = self.optimize(&mut obj, &z0, &bounds, first_step, cap, &curvature)?;
+        let mut outcome = Outcome::at(&z0);
+        let first = self.optimize_onto(
+            &mut obj,
+            &z0,
+            &bounds,
+            first_step,
+            cap,
+            &curvature,
+            &mut outcome,
+            Merge::First,
+        );
+        if let Some(tripped) = obj.tripped {
+            evaluations = evaluations.saturating_add(obj.evaluations);
+            return self.single_tripped(
+                sc,
+                state,
+                track,
+                tripped,
+                obj.best_safe,
+                &outcome,
+                &bounds,
+                h_safe,
+                &mut scan,
+                evaluations,
+            );
+        }
+        first?;
         let mut iterations = outcome.iterations;
         // One track: the verification's bisection finds the safe boundary
         // exactly, a stiffer penalty stage would only cost iterations.
@@ -590,20 +521,18 @@ impl<const K: usize> Planner<K> {
         // The iteration cap bounds the whole solve, all stages together.
         while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 && iterations < cap {
             obj.mu *= PENALTY_GROWTH;
-            let next = self.optimize(
+            let from = outcome.z;
+            let taken = self.optimize_onto(
                 &mut obj,
-                &outcome.z,
+                &from,
                 &bounds,
                 first_step,
                 cap.saturating_sub(iterations),
                 &SVector::zeros(),
+                &mut outcome,
+                Merge::Continue,
             )?;
-            iterations = iterations.saturating_add(next.iterations);
-            let mut history = outcome.history;
-            for &v in next.history.iter().skip(1) {
-                let _ = history.push(v);
-            }
-            outcome = Outcome { history, ..next };
+            iterations = iterations.saturating_add(taken.unwrap_or(0));
         }
         // Plateau escape: a coordinate whose gradient is exactly zero has its
         // pitch reference saturated over the whole track, and no gradient
@@ -644,22 +573,19 @@ impl<const K: usize> Planner<K> {
                     if budget == 0 {
                         break;
                     }
-                    let next = self.optimize(
+                    let taken = self.optimize_onto(
                         &mut obj,
                         &z,
                         &bounds,
                         first_step,
                         budget,
                         &SVector::zeros(),
+                        &mut outcome,
+                        Merge::IfBetter,
                     )?;
-                    if next.j < outcome.j {
+                    if let Some(taken) = taken {
                         // The scan's jump counts as one iteration.
-                        iterations = iterations.saturating_add(next.iterations).saturating_add(1);
-                        let mut history = outcome.history;
-                        for &v in next.history.iter() {
-                            let _ = history.push(v);
-                        }
-                        outcome = Outcome { history, ..next };
+                        iterations = iterations.saturating_add(taken).saturating_add(1);
                     }
                 }
             }
@@ -754,7 +680,73 @@ impl<const K: usize> Planner<K> {
         })
     }
 
-    /// One optimizer run on `obj` from `z0`.
+    /// One more optimizer run on `obj` from `z0` with start `curvature`,
+    /// merged onto `acc` in place: the first run, a continuation (the next penalty stage:
+    /// its history after its start, whose value `acc` ends with) or, with
+    /// [`Merge::IfBetter`], a restart kept only if it ends lower (its whole
+    /// history). Returns the run's iterations, `None` when not kept. Out of
+    /// line, so that the run's own outcome is not a second history-sized
+    /// local of [`Planner::plan`].
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn optimize_onto<const N: usize, const S: usize, const W: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, '_, N, S, W>,
+        z0: &SVector<f32, K>,
+        bounds: &Bounds<K>,
+        first_step: f32,
+        max_iterations: u32,
+        curvature: &SVector<f32, K>,
+        acc: &mut Outcome<K>,
+        merge: Merge,
+    ) -> Result<Option<u32>, PlanError> {
+        // What a rejected restart restores.
+        let kept = (
+            acc.z,
+            acc.j,
+            acc.gradient,
+            acc.grad_norm,
+            acc.status,
+            acc.iterations,
+            acc.evaluations,
+            acc.skipped_updates,
+            acc.history.len(),
+        );
+        if let Merge::First = merge {
+            acc.history.clear();
+        }
+        let continued = matches!(merge, Merge::Continue);
+        self.optimize(
+            obj,
+            z0,
+            bounds,
+            first_step,
+            max_iterations,
+            curvature,
+            acc,
+            continued,
+        )?;
+        // (A NaN objective is not better either.)
+        if let Merge::IfBetter = merge
+            && acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less)
+        {
+            acc.z = kept.0;
+            acc.j = kept.1;
+            acc.gradient = kept.2;
+            acc.grad_norm = kept.3;
+            acc.status = kept.4;
+            acc.iterations = kept.5;
+            acc.evaluations = kept.6;
+            acc.skipped_updates = kept.7;
+            acc.history.truncate(kept.8);
+            return Ok(None);
+        }
+        Ok(Some(acc.iterations))
+    }
+
+    /// One optimizer run on `obj` from `z0`, into `out` (see
+    /// `optim::bfgs::bfgs_into`).
+    #[allow(clippy::too_many_arguments)]
     fn optimize<const N: usize, const S: usize, const W: usize>(
         &self,
         obj: &mut PlanObjective<'_, '_, N, S, W>,
@@ -763,24 +755,35 @@ impl<const K: usize> Planner<K> {
         first_step: f32,
         max_iterations: u32,
         curvature: &SVector<f32, K>,
-    ) -> Result<Outcome<K>, PlanError> {
+        out: &mut Outcome<K>,
+        continued: bool,
+    ) -> Result<(), PlanError> {
         let bfgs = BfgsConfig {
             first_step,
             max_iterations,
             ..self.cfg.bfgs
         };
-        let out = match self.cfg.method {
-            Method::Bfgs => optim::bfgs_from(obj, z0, bounds, &bfgs, &bfgs.armijo, curvature),
+        let r = match self.cfg.method {
+            Method::Bfgs => optim::bfgs::bfgs_into(
+                obj,
+                z0,
+                bounds,
+                &bfgs,
+                &bfgs.armijo,
+                curvature,
+                out,
+                continued,
+            ),
             Method::GradientDescent => {
                 let gd = GdConfig {
                     rate: self.cfg.gd_rate,
                     max_iterations,
                     tol: self.cfg.bfgs.tol,
                 };
-                optim::gradient_descent(obj, z0, bounds, &gd)
+                optim::gd::gradient_descent_into(obj, z0, bounds, &gd, out, continued)
             }
         };
-        out.map_err(|e| match e {
+        r.map_err(|e| match e {
             OptimError::Config(p) => PlanError::Config(p),
             OptimError::Start(e) => PlanError::Sim(e),
             OptimError::NonFinite => PlanError::Sim(SimError::Diverged),
@@ -972,6 +975,245 @@ impl<const K: usize> Planner<K> {
 }
 
 impl<const K: usize> Planner<K> {
+    /// A constrained single track after its scan: decides from the scanned
+    /// minimum altitudes whether the optimum lies beyond the safe set (and
+    /// answers with the boundary search), whether nothing is safe
+    /// (infeasible), or whether the optimizer should run, possibly from a
+    /// better start (module docs). Kept out of line: its locals need not
+    /// sit on the stack while the optimizer runs.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn single_start<const N: usize, const S: usize, const W: usize>(
+        &mut self,
+        sc: &Scenario<'_, N, S, W>,
+        state: &VehicleState<N>,
+        track: usize,
+        scan: &ScanLog,
+        h_safe: f32,
+        z0: &mut SVector<f32, K>,
+        curvature: &mut SVector<f32, K>,
+        evaluations: &mut u32,
+    ) -> Result<Option<Plan<N, K>>, PlanError> {
+        let best = scan
+            .entries()
+            .filter(|e| e.1.is_finite())
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let vertex = z0.get(0).copied().unwrap_or(0.0);
+        // The scanned neighbour of `from` in the direction of `to`.
+        let neighbour = |from: f32, to: f32| {
+            scan.entries()
+                .filter(|e| (e.0 - from) * (to - from) > 0.0)
+                .min_by(|a, b| libm::fabsf(a.0 - from).total_cmp(&libm::fabsf(b.0 - from)))
+        };
+        // A bracket (safe end, unsafe end) of the boundary when the scan
+        // puts the optimum beyond it; `infeasible` when nothing scanned
+        // is safe.
+        let mut bracket: Option<(End, End)> = None;
+        let mut infeasible = false;
+        if let Some((z_best, _, alt_best)) = best {
+            if alt_best < h_safe {
+                let safe = scan
+                    .entries()
+                    .filter(|e| e.2 >= h_safe)
+                    .min_by(|a, b| libm::fabsf(a.0 - z_best).total_cmp(&libm::fabsf(b.0 - z_best)));
+                match safe {
+                    Some(sf) => {
+                        let unsafe_end = neighbour(sf.0, z_best)
+                            .map_or((z_best, Some(alt_best)), |e| (e.0, Some(e.2)));
+                        bracket = Some(((sf.0, Some(sf.2)), unsafe_end));
+                    }
+                    None => infeasible = true,
+                }
+            } else if let Some(n) = neighbour(z_best, vertex)
+                && n.2 < h_safe
+                && libm::fabsf(vertex - z_best) > 0.0
+            {
+                bracket = Some(((z_best, Some(alt_best)), (n.0, Some(n.2))));
+            }
+        }
+        let mut found: Option<(f32, TrackScore, VehicleState<N>, PlanStatus)> = None;
+        if infeasible {
+            // The safest scanned depth.
+            let z = scan
+                .iter()
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .map_or(vertex, |e| e.0);
+            let (score, next) = self.fly(sc, state, track, z, evaluations)?;
+            found = Some((z, score, next, PlanStatus::Infeasible));
+        } else if let Some((good, bad)) = bracket {
+            let b = self.boundary(sc, state, track, good, bad, h_safe, evaluations)?;
+            let (z_b, score, next) = (b.depth, b.score, b.next);
+            // Does `J` decrease from the boundary into the safe set? A
+            // finite difference towards the safe side: the boundary
+            // search's previous safe depth when it is within
+            // `CHECK_STEP` (no extra flight), else one flight there.
+            let inward = good.0 - z_b;
+            let step = CHECK_STEP.min(libm::fabsf(inward)).copysign(inward);
+            let near = b.inner.filter(|p| libm::fabsf(p.0 - z_b) <= CHECK_STEP);
+            let (z_in, j_in) = match near {
+                Some(p) => p,
+                None => {
+                    let z = z_b + step;
+                    let j = self
+                        .fly(sc, state, track, z, evaluations)
+                        .map_or(f32::INFINITY, |(s, _)| s.j());
+                    (z, j)
+                }
+            };
+            let slope = (j_in - score.j()) / (z_in - z_b);
+            if slope * inward < 0.0 {
+                // An interior optimum: optimize from the boundary.
+                if let Some(slot) = z0.get_mut(0) {
+                    *slot = z_b;
+                }
+                *curvature = SVector::zeros();
+            } else {
+                found = Some((z_b, score, next, PlanStatus::SafeFallback));
+            }
+        }
+        if let Some((depth, score, next, status)) = found {
+            let mut history = Vec::new();
+            let _ = history.push(score.j());
+            return Ok(Some(self.single_plan(
+                depth,
+                status,
+                score,
+                next,
+                h_safe,
+                0,
+                *evaluations,
+                history,
+            )));
+        }
+        Ok(None)
+    }
+
+    /// The optimizer of a constrained single track left the safe set at
+    /// `(z_bad, alt_bad)` (m, m): the optimum lies beyond the boundary it
+    /// was descending towards. Searches that boundary between the best safe
+    /// depth it evaluated (or else scanned) and the unsafe one.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
+    fn single_tripped<const N: usize, const S: usize, const W: usize>(
+        &mut self,
+        sc: &Scenario<'_, N, S, W>,
+        state: &VehicleState<N>,
+        track: usize,
+        (z_bad, alt_bad): (f32, f32),
+        best_safe: Option<(f32, f32, f32)>,
+        first: &Outcome<K>,
+        bounds: &Bounds<K>,
+        h_safe: f32,
+        scan: &mut ScanLog,
+        mut evaluations: u32,
+    ) -> Result<Plan<N, K>, PlanError> {
+        // The optimizer left the safe set: the optimum lies beyond the
+        // boundary it was descending towards. Search that boundary
+        // between the best safe depth evaluated (or scanned) and the
+        // unsafe one.
+        let iterations = first.iterations;
+        let mut history = first.history.clone();
+        let good = match best_safe {
+            Some((z, _, alt)) => Some((z, alt)),
+            None => scan
+                .iter()
+                .filter(|e| e.1 >= h_safe)
+                .min_by(|a, b| libm::fabsf(a.0 - z_bad).total_cmp(&libm::fabsf(b.0 - z_bad))),
+        };
+        let (depth, score, next, status) = match good {
+            Some((z_good, alt_good)) => {
+                let b = self.boundary(
+                    sc,
+                    state,
+                    track,
+                    (z_good, Some(alt_good)),
+                    (z_bad, Some(alt_bad)),
+                    h_safe,
+                    &mut evaluations,
+                )?;
+                (b.depth, b.score, b.next, PlanStatus::SafeFallback)
+            }
+            None => {
+                let lo = bounds.lo.get(0).copied().unwrap_or(z_bad);
+                let hi = bounds.hi.get(0).copied().unwrap_or(z_bad);
+                let fb = self.fallback(
+                    sc,
+                    state,
+                    track,
+                    (z_bad, Some(alt_bad)),
+                    lo,
+                    hi,
+                    h_safe,
+                    scan,
+                    &mut evaluations,
+                )?;
+                let status = if fb.safe {
+                    PlanStatus::SafeFallback
+                } else {
+                    PlanStatus::Infeasible
+                };
+                (fb.depth, fb.score, fb.next, status)
+            }
+        };
+        let _ = history.push(score.j());
+        Ok(self.single_plan(
+            depth,
+            status,
+            score,
+            next,
+            h_safe,
+            iterations,
+            evaluations,
+            history,
+        ))
+    }
+
+    /// The answer of a single-track solve decided without the general
+    /// path's verification (the depth's flight is at hand).
+    #[allow(clippy::too_many_arguments)]
+    fn single_plan<const N: usize>(
+        &mut self,
+        depth: f32,
+        status: PlanStatus,
+        score: TrackScore,
+        next: VehicleState<N>,
+        h_safe: f32,
+        iterations: u32,
+        evaluations: u32,
+        history: Vec<f32, HISTORY>,
+    ) -> Plan<N, K> {
+        let mut horizon = [0.0_f32; K];
+        if let Some(first) = horizon.first_mut() {
+            *first = depth;
+        }
+        self.warm = None;
+        crate::log::debug!(
+            "plan: depth {=f32} m, {=str}, J {=f32} m3, min altitude {=f32} m, {=u32} iterations, {=u32} evaluations",
+            depth,
+            status.as_str(),
+            score.j(),
+            score.min_altitude(),
+            iterations,
+            evaluations
+        );
+        Plan {
+            depth,
+            status,
+            safe: score.min_altitude() >= h_safe,
+            j: score.j(),
+            rms: score.rms(),
+            min_altitude: score.min_altitude(),
+            objective: score.j(),
+            iterations,
+            evaluations,
+            grad_norm: 0.0,
+            history,
+            horizon,
+            horizon_len: 1,
+            next_state: next,
+        }
+    }
+
     /// The safe-set boundary between a safe depth `good` (its flight, when
     /// known) and an unsafe one `bad`, from the safe side: the Illinois
     /// variant of regula falsi on `g(z) = min altitude − h_safe`, which is
@@ -1060,6 +1302,17 @@ impl<const K: usize> Planner<K> {
             inner,
         })
     }
+}
+
+/// How [`Planner::optimize_onto`] merges a run.
+#[derive(Clone, Copy)]
+enum Merge {
+    /// The first run: replaces.
+    First,
+    /// A continuation of the last run.
+    Continue,
+    /// A restart, kept only if better.
+    IfBetter,
 }
 
 /// One end of a boundary bracket: a depth (m) and its minimum altitude
@@ -1206,6 +1459,16 @@ struct PlanObjective<'a, 'b, const N: usize, const S: usize, const W: usize> {
     /// With one track: the last depth evaluated, its score and end state,
     /// which the verification then need not fly again.
     last_flight: Option<(f32, TrackScore, VehicleState<N>)>,
+    /// With one track, constrained: the certified altitude `h_a + m_s`. The
+    /// first depth evaluated below it stops the optimizer (every later
+    /// evaluation fails without a flight), so that the boundary search
+    /// takes over from the best safe depth it had reached.
+    guard: Option<f32>,
+    /// That first unsafe depth and its minimum altitude (m, m).
+    tripped: Option<(f32, f32)>,
+    /// The safe depth of least `J` evaluated, with `J` and its minimum
+    /// altitude (m, m³, m).
+    best_safe: Option<(f32, f32, f32)>,
 }
 
 impl<const N: usize, const S: usize, const W: usize, const K: usize> Objective<K>
@@ -1214,11 +1477,23 @@ impl<const N: usize, const S: usize, const W: usize, const K: usize> Objective<K
     type Error = SimError;
 
     fn eval(&mut self, z: &SVector<f32, K>) -> Result<(f32, SVector<f32, K>), SimError> {
+        if self.tripped.is_some() {
+            return Err(SimError::Diverged);
+        }
         self.evaluations = self.evaluations.saturating_add(1);
         let depths: [f32; K] = (*z).into();
         let e = self
             .sc
             .evaluate_tracks(self.start, self.track, &depths, self.count)?;
+        if let (Some(h_safe), 1, Some(&z0)) = (self.guard, self.count, z.get(0)) {
+            if e.min_altitude < h_safe {
+                self.tripped = Some((z0, e.min_altitude));
+                return Err(SimError::Diverged);
+            }
+            if self.best_safe.is_none_or(|b| e.j < b.1) {
+                self.best_safe = Some((z0, e.j, e.min_altitude));
+            }
+        }
         let g = SVector::from(e.grad_j) + SVector::from(e.grad_violation) * self.mu;
         self.last_violation = e.violation;
         self.last_flight = match (self.count, e.scores.first(), z.get(0)) {

@@ -633,7 +633,8 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         let step_len = self.vehicle.speed() * ts;
         // Even flying at 75° on average the line would be done by then.
         let max_steps = 4.0 * (x_end - start.x()) / step_len + 100.0;
-        let max_steps = if max_steps.is_finite() {
+        // Steps left before the run is declared stuck.
+        let mut budget = if max_steps.is_finite() {
             max_steps as u32
         } else {
             u32::MAX
@@ -663,7 +664,6 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         let mut track = first;
         // X_{track+1}: where the active track ends.
         let mut track_end = x_next;
-        let mut steps = 0_u32;
         // θ_k: computed once per step, as θ_{k+1} of the step before.
         let mut pitch = plant.pitch(&st.eta);
         let mut rise = st.depth.diff(st.depth_prev);
@@ -716,11 +716,11 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                 };
                 let mut fast = false;
                 loop {
-                    steps = steps.saturating_add(1);
-                    if steps > max_steps {
+                    let Some(left) = budget.checked_sub(1) else {
                         *score = acc;
                         return Err(SimError::StepLimit);
-                    }
+                    };
+                    budget = left;
                     let (dx, dd) = match self.advance(
                         &mut st,
                         &mut pitch,
@@ -808,10 +808,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
                     };
                 }
             } else {
-                steps = steps.saturating_add(1);
-                if steps > max_steps {
-                    return Err(SimError::StepLimit);
-                }
+                budget = budget.checked_sub(1).ok_or(SimError::StepLimit)?;
                 self.advance(
                     &mut st,
                     &mut pitch,

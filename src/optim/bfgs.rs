@@ -35,7 +35,7 @@
 use nalgebra::{SMatrix, SVector};
 
 use super::{
-    Armijo, Bounds, HISTORY, LineSearch, Objective, OptimError, Outcome, Status, Tolerances, start,
+    Armijo, Bounds, LineSearch, Objective, OptimError, Outcome, Status, Tolerances, start,
 };
 
 /// Relative tolerance of the curvature guard (see the module docs).
@@ -133,6 +133,35 @@ pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     line_search: &L,
     curvature: &SVector<f32, K>,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
+    let mut out = Outcome::at(z0);
+    bfgs_into(
+        obj,
+        z0,
+        bounds,
+        cfg,
+        line_search,
+        curvature,
+        &mut out,
+        false,
+    )?;
+    Ok(out)
+}
+
+/// [`bfgs_from`] writing its result into `out` in place, its objective
+/// values appended to `out.history` (all of them, or all but the start's
+/// with `continued`): a caller that chains runs keeps one history, not a
+/// copy per run on the stack.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
+    obj: &mut O,
+    z0: &SVector<f32, K>,
+    bounds: &Bounds<K>,
+    cfg: &BfgsConfig,
+    line_search: &L,
+    curvature: &SVector<f32, K>,
+    out: &mut Outcome<K>,
+    continued: bool,
+) -> Result<(), OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
     let informed = curvature.iter().any(|&c| c.is_finite() && c > 0.0);
     if !bounds.is_valid() {
@@ -141,8 +170,10 @@ pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut z = bounds.project(z0);
     let (mut j, mut g) = start(obj, &z)?;
     let mut evaluations = 1_u32;
-    let mut history = heapless::Vec::<f32, HISTORY>::new();
-    let _ = history.push(j);
+    let history = &mut out.history;
+    if !continued {
+        let _ = history.push(j);
+    }
     let mut metric: Option<SMatrix<f32, K, K>> = None;
     let mut rescaled = informed;
     let mut skipped_updates = 0_u32;
@@ -221,17 +252,15 @@ pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             break Status::Converged;
         }
     };
-    Ok(Outcome {
-        grad_norm: bounds.free_gradient(&z, &g).norm(),
-        z,
-        j,
-        gradient: g,
-        status,
-        iterations,
-        evaluations,
-        skipped_updates,
-        history,
-    })
+    out.grad_norm = bounds.free_gradient(&z, &g).norm();
+    out.z = z;
+    out.j = j;
+    out.gradient = g;
+    out.status = status;
+    out.iterations = iterations;
+    out.evaluations = evaluations;
+    out.skipped_updates = skipped_updates;
+    Ok(())
 }
 
 /// The BFGS update of `a` for step `dz` and gradient change `y`

@@ -5,7 +5,7 @@
 
 use nalgebra::SVector;
 
-use super::{Bounds, HISTORY, Objective, OptimError, Outcome, Status, Tolerances, start};
+use super::{Bounds, Objective, OptimError, Outcome, Status, Tolerances, start};
 
 /// Gradient-descent settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,6 +47,21 @@ pub fn gradient_descent<const K: usize, O: Objective<K>>(
     bounds: &Bounds<K>,
     cfg: &GdConfig,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
+    let mut out = Outcome::at(z0);
+    gradient_descent_into(obj, z0, bounds, cfg, &mut out, false)?;
+    Ok(out)
+}
+
+/// [`gradient_descent`] writing into `out` in place (see
+/// `bfgs::bfgs_into`).
+pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
+    obj: &mut O,
+    z0: &SVector<f32, K>,
+    bounds: &Bounds<K>,
+    cfg: &GdConfig,
+    out: &mut Outcome<K>,
+    continued: bool,
+) -> Result<(), OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
     if !bounds.is_valid() {
         return Err(OptimError::Config("bounds"));
@@ -54,8 +69,10 @@ pub fn gradient_descent<const K: usize, O: Objective<K>>(
     let mut z = bounds.project(z0);
     let (mut j, mut g) = start(obj, &z)?;
     let mut evaluations = 1_u32;
-    let mut history = heapless::Vec::<f32, HISTORY>::new();
-    let _ = history.push(j);
+    let history = &mut out.history;
+    if !continued {
+        let _ = history.push(j);
+    }
     let mut iterations = 0_u32;
     let status = loop {
         if bounds.free_gradient(&z, &g).norm() <= cfg.tol.grad {
@@ -90,17 +107,15 @@ pub fn gradient_descent<const K: usize, O: Objective<K>>(
             break Status::Converged;
         }
     };
-    Ok(Outcome {
-        grad_norm: bounds.free_gradient(&z, &g).norm(),
-        z,
-        j,
-        gradient: g,
-        status,
-        iterations,
-        evaluations,
-        skipped_updates: 0,
-        history,
-    })
+    out.grad_norm = bounds.free_gradient(&z, &g).norm();
+    out.z = z;
+    out.j = j;
+    out.gradient = g;
+    out.status = status;
+    out.iterations = iterations;
+    out.evaluations = evaluations;
+    out.skipped_updates = 0;
+    Ok(())
 }
 
 #[cfg(test)]

@@ -195,6 +195,23 @@ pub struct Outcome<const K: usize> {
     pub history: Vec<f32, HISTORY>,
 }
 
+impl<const K: usize> Outcome<K> {
+    /// An outcome that has not run: at `z`, no history, `J = +inf`.
+    pub(crate) fn at(z: &SVector<f32, K>) -> Self {
+        Self {
+            z: *z,
+            j: f32::INFINITY,
+            gradient: SVector::zeros(),
+            grad_norm: 0.0,
+            status: Status::Converged,
+            iterations: 0,
+            evaluations: 0,
+            skipped_updates: 0,
+            history: Vec::new(),
+        }
+    }
+}
+
 /// Why an optimizer could not start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
