@@ -516,8 +516,7 @@ impl<const K: usize> Planner<K> {
         // One track: the verification's bisection finds the safe boundary
         // exactly, a stiffer penalty stage would only cost iterations.
         let stages = if h == 1 { 1 } else { self.cfg.penalty_stages };
-        let max_mu =
-            self.cfg.penalty_weight * libm::powf(PENALTY_GROWTH, stages.saturating_sub(1) as f32);
+        let max_mu = (1..stages).fold(self.cfg.penalty_weight, |m, _| m * PENALTY_GROWTH);
         // The iteration cap bounds the whole solve, all stages together.
         while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 && iterations < cap {
             obj.mu *= PENALTY_GROWTH;
@@ -1417,7 +1416,8 @@ fn search_box<const N: usize, const S: usize, const W: usize, const K: usize>(
     h: usize,
 ) -> Bounds<K> {
     let ap = sc.vehicle().autopilot().config();
-    let sin = libm::sinf((1.3 * ap.pitch_limit).min(90.0) * DEG);
+    let angle = ((1.3 * ap.pitch_limit).min(90.0) * DEG).min(core::f32::consts::FRAC_PI_2);
+    let (sin, _) = crate::num::sin_cos(angle);
     let saturation = if ap.depth_pid.kp > 0.0 {
         3.0 * ap.pitch_limit / ap.depth_pid.kp
     } else {

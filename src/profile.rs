@@ -184,7 +184,7 @@ impl<const S: usize> Profile<S> {
     /// The cursor makes the lookups of a simulation, whose `x` moves by a
     /// fraction of a sample spacing per step, O(1) instead of a search.
     /// Returns `None` outside the profile.
-    #[inline(always)]
+    #[inline]
     pub(crate) fn locate(&self, cursor: &mut Cursor, x: Comp) -> Option<Point> {
         let xv = x.value();
         // Fast path: still in the cached segment (plain f32 compares; the

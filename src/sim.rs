@@ -915,7 +915,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     /// A sample's geometry; the bottom is looked up only where scoring
     /// needs it (`x <= x_end`), since the last sample may lie past the
     /// profile.
-    #[inline(always)]
+    #[inline]
     fn geo(&self, cursor: &mut Cursor, x: Comp, d: Comp, x_end: f32) -> Result<Geo, SimError> {
         let past = x.minus(x_end);
         let at = if past <= 0.0 {
@@ -940,7 +940,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     /// Scores segment `s0 → s1`, flown from track `track`, into every track
     /// of `first..last` it overlaps, clipping at the waypoints (§8).
     #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
+    #[inline]
     fn score<Sn: Sensitivity<N>>(
         &self,
         s0: &Geo,
@@ -1013,7 +1013,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     }
 
     /// A piece end at one of the segment's samples, with its altitude.
-    #[inline(always)]
+    #[inline]
     fn sample_end(&self, s: &Geo, first: bool) -> Result<(End, f32), SimError> {
         let a = s.at.ok_or(SimError::OutOfProfile)?;
         let at = if first {
@@ -1025,7 +1025,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
     }
 
     /// A piece end clipped at waypoint `i`, depth interpolated in `x`.
-    #[inline(always)]
+    #[inline]
     fn clip_end(&self, s0: &Geo, dx: f32, dd: f32, i: usize) -> Result<(End, f32), SimError> {
         let c = *self
             .waypoints
