@@ -133,14 +133,15 @@ pub struct PlannerConfig {
     /// at the `μ` the previous call ended with.
     pub penalty_stages: u32,
     /// Penalty margin `m_p` above `h_a` for horizons of two tracks or
-    /// more, m (a single track is penalized at `h_a` itself and its
-    /// boundary found exactly by the verification). Default 0.25.
+    /// more, m (a single track is not penalized: its boundary search finds
+    /// the safe boundary exactly). Default 0.25.
     pub penalty_margin: f32,
     /// Safety margin `m_s` above `h_a` for a depth to be reported safe, m.
     /// Default 0.002: the f32 core's altitudes agree with an f64 reference
-    /// to 2.4e-4 m on the golden fixtures and 4e-4 m on random unseen
-    /// cases, so 2 mm covers them five times over; a wider margin costs `J`
-    /// measurably where `h_r` is a few metres.
+    /// to 5.0e-4 m on the golden fixtures and 9.3e-4 m on 300 random
+    /// unseen cases (`tools/reference/check_plan.py`), so 2 mm covers them
+    /// twice over; a wider margin costs `J` measurably where `h_r` is a few
+    /// metres.
     pub safety_margin: f32,
     /// Depths scanned per track for the starting point, ≥ 2, in horizon
     /// mode and for an unconstrained solve, where the scan alone keeps the
@@ -387,10 +388,10 @@ impl<const K: usize> Planner<K> {
             Mode::TrackWise => 1,
             Mode::Horizon => self.cfg.horizon.min(K).min(remaining),
         };
-        // One track: no penalty margin, since the verification's bisection
-        // then lands on the exact safe boundary instead of `m_p` above it.
-        // A horizon keeps the margin for the tracks after the first, which
-        // no bisection corrects.
+        // One track: no penalty margin, since the boundary search then
+        // lands on the exact safe boundary instead of `m_p` above it. A
+        // horizon keeps the margin for the tracks after the first, which no
+        // boundary search corrects.
         let margin = if h == 1 { 0.0 } else { self.cfg.penalty_margin };
         let penalized = sc
             .clone()
@@ -513,8 +514,8 @@ impl<const K: usize> Planner<K> {
         }
         first?;
         let mut iterations = outcome.iterations;
-        // One track: the verification's bisection finds the safe boundary
-        // exactly, a stiffer penalty stage would only cost iterations.
+        // One track: the boundary search finds the safe boundary exactly,
+        // a stiffer penalty stage would only cost iterations.
         let stages = if h == 1 { 1 } else { self.cfg.penalty_stages };
         let max_mu = (1..stages).fold(self.cfg.penalty_weight, |m, _| m * PENALTY_GROWTH);
         // The iteration cap bounds the whole solve, all stages together.
