@@ -222,12 +222,15 @@ impl<const N: usize, const S: usize, const W: usize> Scenario<'_, N, S, W> {
             return Err(SimError::Diverged);
         }
         let used_scores = scores.get(..count).unwrap_or(&[]);
-        let j = used_scores.iter().map(TrackScore::j).sum();
-        let violation = used_scores.iter().map(TrackScore::violation).sum();
+        let j: f32 = used_scores.iter().map(TrackScore::j).sum();
+        let violation: f32 = used_scores.iter().map(TrackScore::violation).sum();
         let min_altitude = used_scores
             .iter()
             .map(TrackScore::min_altitude)
             .fold(f32::INFINITY, f32::min);
+        if !(j.is_finite() && violation.is_finite() && min_altitude.is_finite()) {
+            return Err(SimError::Diverged);
+        }
         Ok(Evaluation {
             scores,
             j,

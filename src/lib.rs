@@ -83,7 +83,7 @@ pub use planner::{Method, Mode, Plan, PlanError, PlanStatus, Planner, PlannerCon
 pub use plant::{Plant, PlantError, TfKind, TransferFunction};
 pub use profile::{Profile, ProfileError};
 pub use sim::{Sample, Scenario, SimError, TrackScore, VehicleState, WaypointError, Waypoints};
-pub use vehicle::{Mission, Vehicle, VehicleConfig};
+pub use vehicle::{MIN_STEP_LENGTH, Mission, Vehicle, VehicleConfig};
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

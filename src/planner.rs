@@ -37,10 +37,10 @@
 //! horizon). The scan also gives each scanned depth's minimum altitude.
 //! When the scan's best depth is unsafe, or safe but with its parabola
 //! pointing to an unsafe neighbour, the optimum of `J` lies beyond the safe
-//! set, and the constrained optimum on its boundary next to it: a regula
-//! falsi (Illinois) search on the minimum altitude between the nearest
-//! safe and unsafe scanned depths finds it from the safe side in a few
-//! plain flights, and a finite difference of `J` there (the search's
+//! set, and the constrained optimum on its boundary next to it: a root
+//! search on the minimum altitude between the nearest safe and unsafe
+//! scanned depths (a unit-slope step, secants, regula falsi) finds it from
+//! the safe side in one to four plain flights, and a finite difference of `J` there (the search's
 //! previous safe depth, or one more flight) confirms that `J` does not
 //! decrease into the safe set; if it does, BFGS optimizes from there. When
 //! no scanned depth is safe the track is [`PlanStatus::Infeasible`] and the
@@ -154,9 +154,9 @@ pub struct PlannerConfig {
     /// (`tools/reference/check_planner.py`) finds them within 0.5 % of the
     /// best safe `J` on every shared profile.
     pub track_scan_points: u32,
-    /// Most flights of the boundary search (regula falsi, Illinois) towards
-    /// the safe-set boundary. Default 16 (bisection alone would bring a
-    /// 50 m bracket under a millimetre); it usually stops after 2 to 4.
+    /// Most flights of the boundary search towards the safe-set boundary
+    /// (see the module docs). Default 16 (bisection alone would bring a
+    /// 50 m bracket under a millimetre); it usually stops after 1 to 4.
     pub bisection_steps: u32,
 }
 
@@ -384,6 +384,9 @@ impl<const K: usize> Planner<K> {
             .checked_sub(track)
             .filter(|&r| r > 0)
             .ok_or(PlanError::TrackRange)?;
+        // A bad start is the caller's error, named as such (every flight
+        // from it would fail the same way).
+        sc.check_start(state, track)?;
         let h = match self.cfg.mode {
             Mode::TrackWise => 1,
             Mode::Horizon => self.cfg.horizon.min(K).min(remaining),
@@ -1111,7 +1114,7 @@ impl<const K: usize> Planner<K> {
         // boundary it was descending towards. Search that boundary
         // between the best safe depth evaluated (or scanned) and the
         // unsafe one.
-        let iterations = first.iterations;
+        let mut iterations = first.iterations;
         let mut history = first.history.clone();
         let good = match best_safe {
             Some((z, _, alt)) => Some((z, alt)),
@@ -1155,6 +1158,11 @@ impl<const K: usize> Planner<K> {
                 (fb.depth, fb.score, fb.next, status)
             }
         };
+        // The boundary search counts as one iteration, after the optimizer's
+        // (history: the start, then one value per iteration).
+        if !history.is_empty() {
+            iterations = iterations.saturating_add(1);
+        }
         let _ = history.push(score.j());
         Ok(self.single_plan(
             depth,
@@ -1214,14 +1222,23 @@ impl<const K: usize> Planner<K> {
         }
     }
 
-    /// The safe-set boundary between a safe depth `good` (its flight, when
-    /// known) and an unsafe one `bad`, from the safe side: the Illinois
-    /// variant of regula falsi on `g(z) = min altitude − h_safe`, which is
-    /// close to linear in `z` near the boundary, so that a few flights
-    /// bracket it to a millimetre where bisection needs sixteen. Stops when
-    /// the safe end is within `BOUNDARY_ALTITUDE` of `h_safe`, the bracket
-    /// is under `BOUNDARY_DEPTH`, or after `bisection_steps` flights.
-    /// Returns the safe end with its flight.
+    /// The safe-set boundary between a safe depth `good` and an unsafe one
+    /// `bad` (each with its minimum altitude when known), from the safe
+    /// side, by root finding on `g(z) = min altitude − h_safe` inside the
+    /// bracket. `g` is typically a hinge: flat where the track's lowest
+    /// point is passed before the vehicle reaches its reference, falling
+    /// about a metre per metre of reference depth beyond. So the first
+    /// step (and any step after an unsafe flight that gave no usable
+    /// secant) moves from the unsafe end by its altitude deficit, which
+    /// lands on the boundary on the sloped side; then the secant through
+    /// the two latest flights, and the Illinois variant of regula falsi on
+    /// the bracket when the secant falls outside it. Each aims at half the
+    /// tolerance above `h_safe`. Stops when the safe end is within
+    /// a tolerance of `h_safe` (0.2 % of `h_r − h_a`, within 1 mm and
+    /// `BOUNDARY_ALTITUDE`), the bracket is under
+    /// `BOUNDARY_DEPTH`, or after `bisection_steps` flights (bisection
+    /// would need sixteen for a millimetre). Returns the safe end with its
+    /// flight, and the safe end before it.
     #[allow(clippy::too_many_arguments)]
     fn boundary<const N: usize, const S: usize, const W: usize>(
         &self,
@@ -1243,8 +1260,17 @@ impl<const K: usize> Planner<K> {
                 f.0.min_altitude() - h_safe
             }
         };
+        // The altitude tolerance: `J` changes by about `2 δz / (h_r − h_a)`
+        // relatively when the boundary moves by `δz`, so 0.2 % of the
+        // envelope keeps that under 0.4 %; at most `BOUNDARY_ALTITUDE`, at
+        // least a millimetre.
+        let m = sc.mission();
+        let tol = (BOUNDARY_SHARE * (m.reference_altitude() - m.min_altitude()))
+            .clamp(BOUNDARY_DEPTH, BOUNDARY_ALTITUDE);
         let mut bad = bad;
         let mut inner = None;
+        // The two latest flights `(z, g)`, newest first.
+        let mut latest: Option<((f32, f32), (f32, f32))> = None;
         let mut g_bad = match bad_alt {
             Some(a) => a - h_safe,
             None => match self.fly(sc, state, track, bad, evaluations) {
@@ -1255,8 +1281,8 @@ impl<const K: usize> Planner<K> {
         // Which end the last two steps kept (Illinois halves its value).
         let mut kept_good = false;
         let mut kept_bad = false;
-        for _ in 0..self.cfg.bisection_steps {
-            if g_good <= BOUNDARY_ALTITUDE || libm::fabsf(good - bad) <= BOUNDARY_DEPTH {
+        for step in 0..self.cfg.bisection_steps {
+            if g_good <= tol || libm::fabsf(good - bad) <= BOUNDARY_DEPTH {
                 break;
             }
             // Regula falsi, kept inside the middle 98 % of the bracket.
@@ -1265,8 +1291,44 @@ impl<const K: usize> Planner<K> {
             } else {
                 0.5
             };
+            // The first step from the unsafe end instead: where the vehicle
+            // holds its reference depth, the minimum altitude falls metre
+            // for metre as the reference deepens, and is flat where the
+            // minimum is set before the vehicle gets there (a hinge, on
+            // which a secant through a flat end is slow). So move from the
+            // unsafe end by its altitude deficit (plus half the tolerance):
+            // on the hinge's sloped side that lands on the boundary.
+            // Later steps take the secant through the two latest flights
+            // (superlinear on the sloped side) when it falls inside the
+            // bracket, aiming at half the tolerance above the boundary.
+            let width = libm::fabsf(good - bad);
+            let unit = -g_bad + 0.5 * tol;
+            let aim = |z: f32| (z - good) / (bad - good);
+            // The secant, when it has two distinct altitudes and lands
+            // inside the bracket.
+            let secant = latest.and_then(|((z1, g1), (z2, g2))| {
+                let ts = aim(z1 + (0.5 * tol - g1) * (z1 - z2) / (g1 - g2));
+                (libm::fabsf(g1 - g2) > 0.0 && ts > 0.01 && ts < 0.99).then_some(ts)
+            });
+            // The unit step from the unsafe end: first, and whenever the
+            // newest flight was unsafe and gave no usable secant (both on
+            // a flat stretch).
+            let newest_bad = latest.is_none_or(|((_, g1), _)| g1 < 0.0);
+            let t = match secant {
+                _ if step == 0 && g_bad < 0.0 && unit < width => 1.0 - unit / width,
+                Some(ts) => ts,
+                None if newest_bad && g_bad < 0.0 && unit < width => 1.0 - unit / width,
+                None => t,
+            };
             let mid = good + t * (bad - good);
-            match self.fly(sc, state, track, mid, evaluations) {
+            let flown = self.fly(sc, state, track, mid, evaluations);
+            let g_mid = flown
+                .as_ref()
+                .map_or(f32::NEG_INFINITY, |(s, _)| s.min_altitude() - h_safe);
+            latest = g_mid
+                .is_finite()
+                .then(|| ((mid, g_mid), latest.map_or((bad, g_bad), |l| l.0)));
+            match flown {
                 Ok((s, n)) if s.min_altitude() >= h_safe => {
                     if let Some((f, _)) = flight {
                         inner = Some((good, f.j()));
@@ -1330,9 +1392,12 @@ struct Boundary<const N: usize> {
 }
 
 /// The boundary search stops when the safe end is within this much of the
-/// certified altitude `h_a + m_s`, m: 2 cm of depth move the `J` of a
-/// track by far less than the optimizer's tolerance.
+/// certified altitude `h_a + m_s` at most, m (where `h_r − h_a` is 10 m or
+/// more).
 const BOUNDARY_ALTITUDE: f32 = 0.02;
+
+/// ... or within this share of `h_r − h_a`, if less.
+const BOUNDARY_SHARE: f32 = 0.002;
 
 /// The finite-difference step, m, that checks a boundary optimum (`J` must
 /// not decrease into the safe set).
@@ -1343,7 +1408,16 @@ const BOUNDARY_DEPTH: f32 = 1e-3;
 
 /// Point `k` of `n >= 2` evenly spaced over `[lo, hi]`.
 fn grid(lo: f32, hi: f32, k: u32, n: u32) -> f32 {
-    lo + (hi - lo) * (k as f32) / (n.saturating_sub(1).max(1) as f32)
+    let z = lo + (hi - lo) * (k as f32) / (n.saturating_sub(1).max(1) as f32);
+    // Rounding must not put a point outside the box (hence, possibly,
+    // outside the depth limits).
+    if z > hi {
+        hi
+    } else if z < lo {
+        lo
+    } else {
+        z
+    }
 }
 
 struct Fallback<const N: usize> {

@@ -621,12 +621,7 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         if let Some(index) = depths.iter().position(|z| !z.is_finite()) {
             return Err(SimError::NonFiniteDepth { index });
         }
-        if !start.is_finite() {
-            return Err(SimError::NonFiniteState);
-        }
-        if !(start.x.minus(x_begin) >= 0.0 && start.x.minus(x_next) < 0.0) {
-            return Err(SimError::StateOffTrack);
-        }
+        self.check_start(start, first)?;
 
         let plant = self.vehicle.plant();
         let ts = plant.sample_time();
@@ -825,10 +820,39 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
             cur = self.geo(&mut cursor, st.x, st.depth, x_end)?;
             self.score(&prev, &cur, track, first, last, scores, sens)?;
         }
-        if scores.iter().any(|s| !s.min_altitude.is_finite()) {
+        // Finite inputs of absurd magnitude (a bottom 10¹⁸ m down) can
+        // overflow `J` or the violation: never hand out a non-finite score.
+        if scores.iter().any(|s| {
+            !(s.min_altitude.is_finite() && s.j().is_finite() && s.violation().is_finite())
+        }) {
             return Err(SimError::Diverged);
         }
         Ok(st)
+    }
+
+    /// Whether `start` can start a run on track `first`: finite, and at
+    /// `X_first <= x < X_first+1`.
+    ///
+    /// # Errors
+    /// [`SimError::TrackRange`], [`SimError::NonFiniteState`] or
+    /// [`SimError::StateOffTrack`].
+    pub(crate) fn check_start(
+        &self,
+        start: &VehicleState<N>,
+        first: usize,
+    ) -> Result<(), SimError> {
+        let wp = self.waypoints.positions();
+        let x_begin = *wp.get(first).ok_or(SimError::TrackRange)?;
+        let x_next = *wp
+            .get(first.saturating_add(1))
+            .ok_or(SimError::TrackRange)?;
+        if !start.is_finite() {
+            return Err(SimError::NonFiniteState);
+        }
+        if !(start.x.minus(x_begin) >= 0.0 && start.x.minus(x_next) < 0.0) {
+            return Err(SimError::StateOffTrack);
+        }
+        Ok(())
     }
 
     /// One step of the loop (contract §7, steps 2–5) from `st`, whose pitch

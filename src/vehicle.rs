@@ -57,6 +57,9 @@ impl Vehicle<3> {
     }
 }
 
+/// Least distance flown per step `U0 Ts` that [`Vehicle::new`] accepts, m.
+pub const MIN_STEP_LENGTH: f32 = 1e-4;
+
 impl<const N: usize> Vehicle<N> {
     /// Validates `cfg` and discretizes `tf` at `cfg.sample_time`.
     ///
@@ -65,6 +68,15 @@ impl<const N: usize> Vehicle<N> {
     pub fn new(cfg: &VehicleConfig, tf: TransferFunction<N>) -> Result<Self, ConfigError> {
         positive(cfg.speed, "speed")?;
         positive(cfg.sample_time, "sample_time")?;
+        // The distance flown per step, `U0 Ts`, bounds a simulation's step
+        // count (a line of `L` metres takes about `L / (U0 Ts)` steps), so
+        // it must not underflow: below a tenth of a millimetre per step
+        // (say 1 mm/s sampled at 10 kHz) a 4 km line would already take
+        // forty million steps.
+        let step = cfg.speed * cfg.sample_time;
+        if step.is_nan() || step < MIN_STEP_LENGTH {
+            return Err(ConfigError::OutOfRange("speed × sample_time"));
+        }
         let autopilot = Autopilot::new(&cfg.autopilot, &tf, cfg.sample_time)?;
         let plant = Plant::new(tf, cfg.sample_time)?;
         let v = Self {
@@ -259,6 +271,18 @@ mod tests {
             Vehicle::new(&cfg, TransferFunction::C_AUV4),
             Err(ConfigError::NotPositive("sample_time"))
         );
+        // Each positive, their product (the step) below 0.1 mm or zero.
+        for (speed, sample_time) in [(1e-23, 1e-23), (1e-3, 1e-2)] {
+            cfg = VehicleConfig {
+                speed,
+                sample_time,
+                ..Default::default()
+            };
+            assert_eq!(
+                Vehicle::new(&cfg, TransferFunction::C_AUV4),
+                Err(ConfigError::OutOfRange("speed × sample_time"))
+            );
+        }
         assert!(Vehicle::c_auv4().is_ok());
     }
 

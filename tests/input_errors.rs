@@ -166,6 +166,22 @@ fn non_positive_speed_or_sample_time() {
 }
 
 #[test]
+fn step_length_below_a_tenth_of_a_millimetre() {
+    // Each positive, the step they make (U0 Ts) too short or underflowing.
+    for (speed, sample_time) in [(1e-23_f32, 1e-23_f32), (1e-3, 1e-2)] {
+        assert_eq!(
+            vehicle(|c| {
+                c.speed = speed;
+                c.sample_time = sample_time;
+            })
+            .unwrap_err(),
+            ConfigError::OutOfRange("speed × sample_time")
+        );
+    }
+    assert!(vehicle(|c| c.speed = 0.01).is_ok());
+}
+
+#[test]
 fn non_finite_parameter() {
     assert_eq!(
         vehicle(|c| c.speed = f32::NAN).unwrap_err(),
@@ -336,6 +352,27 @@ fn non_finite_reference_depth_or_state() {
         sc.evaluate::<1>(&bad, 0, &[200.0]).unwrap_err(),
         SimError::NonFiniteState
     );
+}
+
+#[test]
+fn planner_names_a_bad_start_state() {
+    let (v, p, w) = line();
+    let sc = Scenario::new(&v, &p, &w, Mission::default()).unwrap();
+    for (st, e) in [
+        (
+            VehicleState::<3>::trimmed(f32::NAN, 0.0),
+            SimError::NonFiniteState,
+        ),
+        (
+            VehicleState::<3>::trimmed(220.0, 600.0),
+            SimError::StateOffTrack,
+        ),
+    ] {
+        let mut one = Planner::<1>::new(PlannerConfig::default()).unwrap();
+        assert_eq!(one.plan(&sc, &st, 0).unwrap_err(), PlanError::Sim(e));
+        let mut two = Planner::<2>::new(PlannerConfig::default()).unwrap();
+        assert_eq!(two.plan(&sc, &st, 0).unwrap_err(), PlanError::Sim(e));
+    }
 }
 
 #[test]
