@@ -125,6 +125,22 @@ pub struct PidTerms {
     pub d: f32,
 }
 
+impl PidTerms {
+    /// The terms saturated to ±`f32::MAX`: a term that overflowed (absurd
+    /// but finite inputs or gains) reads as the largest finite value, so
+    /// that telemetry is never infinite. (The command itself is clamped
+    /// to its limit either way.)
+    #[inline(always)]
+    fn saturated(self) -> Self {
+        let s = |v: f32| clamp(v, f32::MAX);
+        Self {
+            p: s(self.p),
+            i: s(self.i),
+            d: s(self.d),
+        }
+    }
+}
+
 /// What the cascade commands at one sample, with every term for telemetry.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -133,9 +149,11 @@ pub struct Command {
     pub pitch_ref: f32,
     /// Elevator `δ`, deg (clamped to ±δmax).
     pub elevator: f32,
-    /// Depth-loop terms (their sum is the unclamped `v`, deg).
+    /// Depth-loop terms (their sum is the unclamped `v`, deg; each
+    /// saturated to ±`f32::MAX`).
     pub depth_terms: PidTerms,
-    /// Pitch-loop terms (their sum is the unclamped `w`, deg).
+    /// Pitch-loop terms (their sum is the unclamped `w`, deg; saturated
+    /// likewise).
     pub pitch_terms: PidTerms,
     /// `θref` lies inside its limits (the clamp is not active).
     pub pitch_ref_linear: bool,
@@ -274,8 +292,8 @@ impl Autopilot {
         Command {
             pitch_ref,
             elevator,
-            depth_terms,
-            pitch_terms,
+            depth_terms: depth_terms.saturated(),
+            pitch_terms: pitch_terms.saturated(),
             pitch_ref_linear,
             elevator_linear,
             depth_integrating,

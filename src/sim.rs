@@ -373,7 +373,8 @@ impl TrackScore {
     }
     /// RMS deviation from the target depth `sqrt(2 J / (X_{i+1} − X_i))`, m.
     pub fn rms(&self) -> f32 {
-        libm::sqrtf(2.0 * self.j() / (self.x_end - self.x_start))
+        // √J · √(2 / L): no overflow of `2 J` where `J` is near f32's range.
+        libm::sqrtf(self.j()) * libm::sqrtf(2.0 / (self.x_end - self.x_start))
     }
     /// Constraint violation `½ ∫ max(0, h_p − h)² dx` by the same
     /// trapezoid, m³, with `h_p` the scenario's penalty altitude (`h_a`

@@ -180,7 +180,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut iterations = 0_u32;
 
     let status = loop {
-        let grad_norm = bounds.free_gradient(&z, &g).norm();
+        let grad_norm = bounds.free_gradient_norm(&z, &g);
         // Stopping rule 3.14a.
         if grad_norm <= cfg.tol.grad {
             break Status::Converged;
@@ -252,7 +252,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             break Status::Converged;
         }
     };
-    out.grad_norm = bounds.free_gradient(&z, &g).norm();
+    out.grad_norm = bounds.free_gradient_norm(&z, &g);
     out.z = z;
     out.j = j;
     out.gradient = g;

@@ -75,7 +75,7 @@ pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
     }
     let mut iterations = 0_u32;
     let status = loop {
-        if bounds.free_gradient(&z, &g).norm() <= cfg.tol.grad {
+        if bounds.free_gradient_norm(&z, &g) <= cfg.tol.grad {
             break Status::Converged;
         }
         if iterations >= cfg.max_iterations {
@@ -107,7 +107,7 @@ pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
             break Status::Converged;
         }
     };
-    out.grad_norm = bounds.free_gradient(&z, &g).norm();
+    out.grad_norm = bounds.free_gradient_norm(&z, &g);
     out.z = z;
     out.j = j;
     out.gradient = g;

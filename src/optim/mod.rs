@@ -86,6 +86,18 @@ impl<const K: usize> Bounds<K> {
         })
     }
 
+    /// The norm of [`Bounds::free_gradient`], computed without overflow
+    /// (scaled by its largest component): finite for any finite gradient.
+    pub fn free_gradient_norm(&self, z: &SVector<f32, K>, g: &SVector<f32, K>) -> f32 {
+        let f = self.free_gradient(z, g);
+        let m = f.amax();
+        if m > 0.0 && m.is_finite() {
+            m * (f / m).norm()
+        } else {
+            f.norm()
+        }
+    }
+
     /// `true` when every bound is finite and `lo <= hi`.
     pub fn is_valid(&self) -> bool {
         self.lo
