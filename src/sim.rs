@@ -842,6 +842,12 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         }) {
             return Err(SimError::Diverged);
         }
+        // An absurd but finite reference (10³⁸ m) can drive the depth
+        // integral out of range without upsetting the flight, which the
+        // clamps keep finite: the end state, handed out, must be finite.
+        if !st.is_finite() {
+            return Err(SimError::Diverged);
+        }
         Ok(st)
     }
 

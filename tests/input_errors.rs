@@ -355,6 +355,20 @@ fn non_finite_reference_depth_or_state() {
 }
 
 #[test]
+fn absurd_reference_depth_gives_no_infinite_state() {
+    // Found by fuzzing: a finite reference of -1.7e38 m drove the depth
+    // integral to -inf while the clamped flight stayed finite.
+    let (v, p, w) = line();
+    let sc = Scenario::new(&v, &p, &w, Mission::default()).unwrap();
+    let st = sc.start_state(220.0);
+    let mut s = [TrackScore::default()];
+    match sc.simulate(&st, 0, &[-1.7e38], &mut s, |_| {}) {
+        Ok(end) => assert!(end.depth_integral().is_finite() && s[0].j().is_finite()),
+        Err(e) => assert_eq!(e, SimError::Diverged),
+    }
+}
+
+#[test]
 fn planner_names_a_bad_start_state() {
     let (v, p, w) = line();
     let sc = Scenario::new(&v, &p, &w, Mission::default()).unwrap();
