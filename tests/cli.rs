@@ -259,6 +259,27 @@ fn bad_command_lines() {
     bad(&["--depths"], "needs a value");
 }
 
+/// An argument that is not UTF-8 is a usage error, not a panic in
+/// `std::env::args` (found while writing the fuzz target of its parsers).
+#[cfg(unix)]
+#[test]
+fn non_utf8_argument() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let out = Command::new(tool())
+        .args([OsStr::new("--config"), OsStr::from_bytes(b"v\xff.toml")])
+        .output()
+        .unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(2), "stderr {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "not one line: {err:?}");
+    assert!(
+        err.contains("argument 2") && err.contains("UTF-8"),
+        "{err:?}"
+    );
+}
+
 fn json_of(args: &[&str]) -> serde_json::Value {
     let out = run(args);
     assert_eq!(

@@ -1,8 +1,10 @@
 //! Command-line arguments of `plan` (spec/cli.md).
 
+use std::ffi::OsString;
 use std::path::PathBuf;
 
 use crate::fail::Fail;
+use crate::input::MAX_HORIZON;
 
 /// Optimizer choice.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -40,6 +42,24 @@ pub const USAGE: &str = "usage: plan [--profile PROFILE.csv --waypoints WAYPOINT
 [--json] [--trajectory OUT.csv] [--plot OUT.svg]";
 
 impl Args {
+    /// Parses the arguments as the operating system passes them: one that
+    /// is not UTF-8 is a usage error (`std::env::args` would panic).
+    pub fn parse_os(it: impl Iterator<Item = OsString>) -> Result<Self, Fail> {
+        let args = it
+            .enumerate()
+            .map(|(i, a)| {
+                a.into_string().map_err(|a| {
+                    Fail::usage(format!(
+                        "argument {} ('{}') is not valid UTF-8",
+                        i + 1,
+                        a.to_string_lossy()
+                    ))
+                })
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Self::parse(args.into_iter())
+    }
+
     /// Parses `--flag value` and `--flag=value` forms.
     pub fn parse(mut it: impl Iterator<Item = String>) -> Result<Self, Fail> {
         let mut a = Args {
@@ -98,11 +118,11 @@ impl Args {
                 "--horizon" => {
                     let v = value("--horizon")?;
                     match v.trim().parse::<usize>() {
-                        Ok(k) if (1..=crate::MAX_HORIZON).contains(&k) => a.horizon = Some(k),
+                        Ok(k) if (1..=MAX_HORIZON).contains(&k) => a.horizon = Some(k),
                         _ => {
                             return Err(Fail::usage(format!(
                                 "--horizon must be a whole number of tracks from 1 to {}, got '{v}'",
-                                crate::MAX_HORIZON
+                                MAX_HORIZON
                             )));
                         }
                     }

@@ -9,6 +9,12 @@ use crate::fail::Fail;
 
 /// Plant order capacity of the host tool.
 pub const ORDER: usize = 8;
+/// Profile capacity of the host tool (samples).
+pub const SAMPLES: usize = 20_000;
+/// Waypoint capacity of the host tool.
+pub const WAYPOINTS: usize = 256;
+/// Most tracks the host tool optimizes jointly in horizon mode.
+pub const MAX_HORIZON: usize = 8;
 
 /// The bundled default line (spec/cli.md): Monterey Canyon 1.
 pub const BUNDLED_PROFILE: &str = include_str!("../../data/bathymetry/us_monterey_canyon_1.csv");

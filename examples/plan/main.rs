@@ -21,17 +21,11 @@ use auvnav::{
 
 use args::Args;
 use fail::Fail;
+use input::{MAX_HORIZON, SAMPLES, WAYPOINTS};
 use report::{Report, TrackReport, TrajRow};
 
-/// Profile capacity of the host tool (samples).
-const SAMPLES: usize = 20_000;
-/// Waypoint capacity of the host tool.
-const WAYPOINTS: usize = 256;
-/// Most tracks the host tool optimizes jointly in horizon mode.
-pub const MAX_HORIZON: usize = 8;
-
 fn main() -> ExitCode {
-    match run(Args::parse(std::env::args().skip(1))) {
+    match run(Args::parse_os(std::env::args_os().skip(1))) {
         Ok(()) => ExitCode::SUCCESS,
         Err(Fail::Help) => {
             println!("{}", args::USAGE);
