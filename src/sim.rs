@@ -842,10 +842,14 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         }) {
             return Err(SimError::Diverged);
         }
-        // An absurd but finite reference (10³⁸ m) can drive the depth
-        // integral out of range without upsetting the flight, which the
-        // clamps keep finite: the end state, handed out, must be finite.
-        if !st.is_finite() {
+        // An absurd but finite reference (10³⁸ m) can drive an integrator
+        // out of range without upsetting the flight, which the clamps keep
+        // finite: the end state, handed out, must be finite. (Position and
+        // depth are, or the flight would have failed.)
+        if !(st.depth_integral.is_finite()
+            && st.pitch_integral.is_finite()
+            && st.eta.iter().all(|v| v.is_finite()))
+        {
             return Err(SimError::Diverged);
         }
         Ok(st)
