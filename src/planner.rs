@@ -683,7 +683,8 @@ impl<const K: usize> Planner<K> {
         })
     }
 
-    /// One more optimizer run on `obj` from `z0` with start `curvature`,
+    /// One optimizer run (BFGS or GD, as configured, writing in place; see
+    /// `optim::bfgs::bfgs_into`) on `obj` from `z0` with start `curvature`,
     /// merged onto `acc` in place: the first run, a continuation (the next penalty stage:
     /// its history after its start, whose value `acc` ends with) or, with
     /// [`Merge::IfBetter`], a restart kept only if it ends lower (its whole
@@ -719,16 +720,36 @@ impl<const K: usize> Planner<K> {
             acc.history.clear();
         }
         let continued = matches!(merge, Merge::Continue);
-        self.optimize(
-            obj,
-            z0,
-            bounds,
+        let bfgs = BfgsConfig {
             first_step,
             max_iterations,
-            curvature,
-            acc,
-            continued,
-        )?;
+            ..self.cfg.bfgs
+        };
+        let run = match self.cfg.method {
+            Method::Bfgs => optim::bfgs::bfgs_into(
+                obj,
+                z0,
+                bounds,
+                &bfgs,
+                &bfgs.armijo,
+                curvature,
+                acc,
+                continued,
+            ),
+            Method::GradientDescent => {
+                let gd = GdConfig {
+                    rate: self.cfg.gd_rate,
+                    max_iterations,
+                    tol: self.cfg.bfgs.tol,
+                };
+                optim::gd::gradient_descent_into(obj, z0, bounds, &gd, acc, continued)
+            }
+        };
+        run.map_err(|e| match e {
+            OptimError::Config(p) => PlanError::Config(p),
+            OptimError::Start(e) => PlanError::Sim(e),
+            OptimError::NonFinite => PlanError::Sim(SimError::Diverged),
+        })?;
         // (A NaN objective is not better either.)
         if let Merge::IfBetter = merge
             && acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less)
@@ -745,52 +766,6 @@ impl<const K: usize> Planner<K> {
             return Ok(None);
         }
         Ok(Some(acc.iterations))
-    }
-
-    /// One optimizer run on `obj` from `z0`, into `out` (see
-    /// `optim::bfgs::bfgs_into`).
-    #[allow(clippy::too_many_arguments)]
-    fn optimize<const N: usize, const S: usize, const W: usize>(
-        &self,
-        obj: &mut PlanObjective<'_, '_, N, S, W>,
-        z0: &SVector<f32, K>,
-        bounds: &Bounds<K>,
-        first_step: f32,
-        max_iterations: u32,
-        curvature: &SVector<f32, K>,
-        out: &mut Outcome<K>,
-        continued: bool,
-    ) -> Result<(), PlanError> {
-        let bfgs = BfgsConfig {
-            first_step,
-            max_iterations,
-            ..self.cfg.bfgs
-        };
-        let r = match self.cfg.method {
-            Method::Bfgs => optim::bfgs::bfgs_into(
-                obj,
-                z0,
-                bounds,
-                &bfgs,
-                &bfgs.armijo,
-                curvature,
-                out,
-                continued,
-            ),
-            Method::GradientDescent => {
-                let gd = GdConfig {
-                    rate: self.cfg.gd_rate,
-                    max_iterations,
-                    tol: self.cfg.bfgs.tol,
-                };
-                optim::gd::gradient_descent_into(obj, z0, bounds, &gd, out, continued)
-            }
-        };
-        r.map_err(|e| match e {
-            OptimError::Config(p) => PlanError::Config(p),
-            OptimError::Start(e) => PlanError::Sim(e),
-            OptimError::NonFinite => PlanError::Sim(SimError::Diverged),
-        })
     }
 
     /// Flies `track` alone at depth `z` from `state`.
@@ -938,10 +913,7 @@ impl<const K: usize> Planner<K> {
                 }
             }
         }
-        let nearest_safe = log
-            .iter()
-            .filter(|&(_, alt)| alt >= h_safe)
-            .min_by(|a, b| libm::fabsf(a.0 - z_opt).total_cmp(&libm::fabsf(b.0 - z_opt)));
+        let nearest_safe = log.nearest_safe(z_opt, h_safe).map(|e| (e.0, e.2));
         match nearest_safe {
             Some((z_safe, alt_safe)) => {
                 let b = self.boundary(
@@ -1015,10 +987,7 @@ impl<const K: usize> Planner<K> {
         let mut infeasible = false;
         if let Some((z_best, _, alt_best)) = best {
             if alt_best < h_safe {
-                let safe = scan
-                    .entries()
-                    .filter(|e| e.2 >= h_safe)
-                    .min_by(|a, b| libm::fabsf(a.0 - z_best).total_cmp(&libm::fabsf(b.0 - z_best)));
+                let safe = scan.nearest_safe(z_best, h_safe);
                 match safe {
                     Some(sf) => {
                         let unsafe_end = neighbour(sf.0, z_best)
@@ -1118,10 +1087,7 @@ impl<const K: usize> Planner<K> {
         let mut history = first.history.clone();
         let good = match best_safe {
             Some((z, _, alt)) => Some((z, alt)),
-            None => scan
-                .iter()
-                .filter(|e| e.1 >= h_safe)
-                .min_by(|a, b| libm::fabsf(a.0 - z_bad).total_cmp(&libm::fabsf(b.0 - z_bad))),
+            None => scan.nearest_safe(z_bad, h_safe).map(|e| (e.0, e.2)),
         };
         let (depth, score, next, status) = match good {
             Some((z_good, alt_good)) => {
@@ -1468,6 +1434,14 @@ impl ScanLog {
             .copied()
             .zip(self.alt.iter().copied())
             .take(self.len)
+    }
+
+    /// The entry `(z, J, alt)` nearest to `z` (m) whose minimum altitude is
+    /// at least `h_safe` (m), if any.
+    fn nearest_safe(&self, z: f32, h_safe: f32) -> Option<(f32, f32, f32)> {
+        self.entries()
+            .filter(|e| e.2 >= h_safe)
+            .min_by(|a, b| libm::fabsf(a.0 - z).total_cmp(&libm::fabsf(b.0 - z)))
     }
 
     /// `(z, J, alt)` of each entry.
