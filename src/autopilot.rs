@@ -258,7 +258,8 @@ impl Autopilot {
             d: g.kd * depth_rate,
         };
         let v = depth_terms.p + depth_terms.i + depth_terms.d;
-        let pitch_ref = clamp(v, self.cfg.pitch_limit);
+        // The depth loop's output is `−(…)`: the error pushing it up is `−e_d`.
+        let (pitch_ref, depth_integrating) = saturate(v, self.cfg.pitch_limit, -e_d);
 
         let e_t = pitch_ref - pitch;
         let g = &self.signed_pitch;
@@ -268,19 +269,9 @@ impl Autopilot {
             d: -g.kd * pitch_rate,
         };
         let w = pitch_terms.p + pitch_terms.i + pitch_terms.d;
-        let elevator = clamp(w, self.cfg.elevator_limit);
-
-        // Conditional integration: hold an integrator only while its output
-        // is saturated and integrating would drive it further out. The depth
-        // loop's output is −(…), so a negative error pushes it up: it holds
-        // on `v > θmax` with `e_d < 0` and on `v < −θmax` with `e_d > 0`.
-        // With the clamp's excess `v − θref` (zero inside the limits, of
-        // the sign of `v` outside) that is `(v − θref) e_d < 0`. The pitch
-        // loop likewise, with its sign `σ`: it holds on `w > δmax` with
-        // `σ e_θ > 0` and on `w < −δmax` with `σ e_θ < 0`, that is
-        // `(w − δ) σ e_θ > 0`. (One product and compare each, no branches.)
-        let depth_integrating = (v - pitch_ref) * e_d >= 0.0;
-        let pitch_integrating = (w - elevator) * (self.sign * e_t) <= 0.0;
+        // The pitch loop's output is `σ (…)`: the error pushing it up is
+        // `σ e_θ`.
+        let (elevator, pitch_integrating) = saturate(w, self.cfg.elevator_limit, self.sign * e_t);
         if depth_integrating {
             *depth_integral += self.sample_time * e_d;
         }
@@ -302,12 +293,76 @@ impl Autopilot {
     }
 }
 
+/// A loop's output `u` clamped to `±limit`, and whether its integrator
+/// integrates (conditional integration, contract §7): it holds only while
+/// the output is saturated and integrating would drive it further out,
+/// that is on `u > limit` with `push > 0` or on `u < −limit` with
+/// `push < 0`, where `push` is the loop's error signed as it pushes the
+/// output up. With the clamp's excess `u − clamp(u)` (zero inside the
+/// limits, of the sign of `u` outside) that is `(u − clamp(u)) push > 0`:
+/// one product and compare.
+///
+/// Inside the limits, the common case, the clamp is the identity and the
+/// excess zero, so the integrator integrates: the one compare of `|u|`
+/// decides it and the rest stays out of the way. (NaN takes the general
+/// branch: NaN out, no integration. An infinite `push` makes the loop's
+/// proportional term, and so `u`, infinite or NaN: the general branch
+/// too, as in the general form.)
+#[inline(always)]
+fn saturate(u: f32, limit: f32, push: f32) -> (f32, bool) {
+    if libm::fabsf(u) <= limit {
+        (u, true)
+    } else {
+        let c = clamp(u, limit);
+        (c, (u - c) * push <= 0.0)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn ap() -> Autopilot {
         Autopilot::new(&AutopilotConfig::default(), &TransferFunction::C_AUV4, 0.1).unwrap()
+    }
+
+    #[test]
+    fn saturate_is_the_clamp_and_the_excess_test() {
+        // The one-compare fast branch must agree with the general form,
+        // `(clamp(u), (u − clamp(u)) push <= 0)` for every `u` (zeros, the
+        // limit itself, infinities and NaN) and every finite `push`. (An
+        // infinite error makes the loop's proportional term, and so `u`,
+        // infinite or NaN: the general branch.)
+        let vals = [
+            0.0,
+            -0.0,
+            1e-30,
+            -1e-30,
+            0.5,
+            -0.5,
+            14.999_999,
+            15.0,
+            -15.0,
+            15.000_001,
+            -15.000_001,
+            1e30,
+            -1e30,
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        for &u in &vals {
+            for &push in vals.iter().filter(|p| p.is_finite()) {
+                for limit in [15.0, 1e-3, f32::MAX] {
+                    let c = clamp(u, limit);
+                    let general = (c, (u - c) * push <= 0.0);
+                    let fast = saturate(u, limit, push);
+                    assert_eq!(fast.0.to_bits(), general.0.to_bits(), "{u} {limit} {push}");
+                    assert_eq!(fast.1, general.1, "{u} {limit} {push}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -111,6 +111,13 @@ pub(crate) fn sin_cos(x: f32) -> (f32, f32) {
     {
         return (f32::NAN, f32::NAN);
     }
+    sin_cos_long(x)
+}
+
+/// The degree-9/10 polynomials of [`sin_cos`] (`|x| <= π/2`, radians; not
+/// checked).
+#[inline(always)]
+pub(crate) fn sin_cos_long(x: f32) -> (f32, f32) {
     let x2 = x * x;
     let s = x * (1.0 + x2 * (SIN[0] + x2 * (SIN[1] + x2 * (SIN[2] + x2 * SIN[3]))));
     let c = 1.0 + x2 * (COS[0] + x2 * (COS[1] + x2 * (COS[2] + x2 * (COS[3] + x2 * COS[4]))));

@@ -928,12 +928,16 @@ impl<'a, const N: usize, const S: usize, const W: usize> Scenario<'a, N, S, W> {
         // A cruising vehicle's mean pitch is within ±45°: the short
         // polynomials, whose results are finite with `cos > 0`. Beyond (or
         // NaN, from a diverging loop), the checked general case.
-        let (sin, cos) = if libm::fabsf(mean) <= crate::num::SHORT {
+        let abs = libm::fabsf(mean);
+        let (sin, cos) = if abs <= crate::num::SHORT {
             crate::num::sin_cos_short(mean)
         } else {
-            let (sin, cos) = crate::num::sin_cos(mean);
-            // NaN fails `cos > 0` too.
-            if !(cos > 0.0 && sin.is_finite()) {
+            // Inline, not a call: a call in the loop would cost register
+            // spills on every step.
+            let (sin, cos) = crate::num::sin_cos_long(mean);
+            // Beyond ±90° (or NaN) the vehicle flies backwards: the loop
+            // has diverged. (NaN fails the compare too.)
+            if !(abs <= core::f32::consts::FRAC_PI_2 && cos > 0.0) {
                 return Err(SimError::Diverged);
             }
             (sin, cos)
