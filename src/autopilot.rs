@@ -259,7 +259,8 @@ impl Autopilot {
         };
         let v = depth_terms.p + depth_terms.i + depth_terms.d;
         // The depth loop's output is `−(…)`: the error pushing it up is `−e_d`.
-        let (pitch_ref, depth_integrating) = saturate(v, self.cfg.pitch_limit, -e_d);
+        let depth_out = saturate(v, self.cfg.pitch_limit, -e_d);
+        let pitch_ref = depth_out.value;
 
         let e_t = pitch_ref - pitch;
         let g = &self.signed_pitch;
@@ -271,29 +272,29 @@ impl Autopilot {
         let w = pitch_terms.p + pitch_terms.i + pitch_terms.d;
         // The pitch loop's output is `σ (…)`: the error pushing it up is
         // `σ e_θ`.
-        let (elevator, pitch_integrating) = saturate(w, self.cfg.elevator_limit, self.sign * e_t);
-        if depth_integrating {
+        let pitch_out = saturate(w, self.cfg.elevator_limit, self.sign * e_t);
+        let elevator = pitch_out.value;
+        if depth_out.integrating {
             *depth_integral += self.sample_time * e_d;
         }
-        if pitch_integrating {
+        if pitch_out.integrating {
             *pitch_integral += self.sample_time * e_t;
         }
-        let pitch_ref_linear = libm::fabsf(v) <= self.cfg.pitch_limit;
-        let elevator_linear = libm::fabsf(w) <= self.cfg.elevator_limit;
         Command {
             pitch_ref,
             elevator,
             depth_terms: depth_terms.saturated(),
             pitch_terms: pitch_terms.saturated(),
-            pitch_ref_linear,
-            elevator_linear,
-            depth_integrating,
-            pitch_integrating,
+            pitch_ref_linear: depth_out.linear,
+            elevator_linear: pitch_out.linear,
+            depth_integrating: depth_out.integrating,
+            pitch_integrating: pitch_out.integrating,
         }
     }
 }
 
-/// A loop's output `u` clamped to `±limit`, and whether its integrator
+/// A loop's output `u` clamped to `±limit`, whether the clamp is inactive,
+/// and whether its integrator
 /// integrates (conditional integration, contract §7): it holds only while
 /// the output is saturated and integrating would drive it further out,
 /// that is on `u > limit` with `push > 0` or on `u < −limit` with
@@ -308,13 +309,32 @@ impl Autopilot {
 /// branch: NaN out, no integration. An infinite `push` makes the loop's
 /// proportional term, and so `u`, infinite or NaN: the general branch
 /// too, as in the general form.)
+/// What [`saturate`] gives: the clamped output and the two flags.
+#[derive(Clone, Copy)]
+struct Saturated {
+    /// `clamp(u)`, in the unit of `u`.
+    value: f32,
+    /// `|u| <= limit` (the clamp is not active; false for NaN).
+    linear: bool,
+    /// The integrator integrates at this sample.
+    integrating: bool,
+}
+
 #[inline(always)]
-fn saturate(u: f32, limit: f32, push: f32) -> (f32, bool) {
+fn saturate(u: f32, limit: f32, push: f32) -> Saturated {
     if libm::fabsf(u) <= limit {
-        (u, true)
+        Saturated {
+            value: u,
+            linear: true,
+            integrating: true,
+        }
     } else {
         let c = clamp(u, limit);
-        (c, (u - c) * push <= 0.0)
+        Saturated {
+            value: c,
+            linear: false,
+            integrating: (u - c) * push <= 0.0,
+        }
     }
 }
 
@@ -358,8 +378,12 @@ mod tests {
                     let c = clamp(u, limit);
                     let general = (c, (u - c) * push <= 0.0);
                     let fast = saturate(u, limit, push);
-                    assert_eq!(fast.0.to_bits(), general.0.to_bits(), "{u} {limit} {push}");
-                    assert_eq!(fast.1, general.1, "{u} {limit} {push}");
+                    assert_eq!(
+                        fast.value.to_bits(),
+                        general.0.to_bits(),
+                        "{u} {limit} {push}"
+                    );
+                    assert_eq!(fast.integrating, general.1, "{u} {limit} {push}");
                 }
             }
         }
