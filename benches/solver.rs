@@ -45,7 +45,6 @@ use argmin::solver::quasinewton::BFGS;
 use auvnav::optim::{self, BfgsConfig, Bounds, GdConfig, Objective, Tolerances};
 use auvnav::{Mission, Profile, Scenario, TrackScore, Vehicle, VehicleState, Waypoints};
 use criterion::{Criterion, Throughput, criterion_group};
-use nalgebra::SVector;
 
 const PROFILE: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.csv");
 const WAYPOINTS: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.waypoints.csv");
@@ -85,29 +84,29 @@ fn setup() -> Setup {
     }
 }
 
-fn scenario(s: &Setup) -> Scenario<'_, 3, 256, 8> {
+fn scenario(s: &Setup) -> Scenario<'_, 3> {
     Scenario::new(&s.vehicle, &s.profile, &s.waypoints, Mission::default()).unwrap()
 }
 
 /// The state at waypoint 1 after flying track 1 at 866.86 m.
-fn start(sc: &Scenario<'_, 3, 256, 8>) -> VehicleState<3> {
+fn start(sc: &Scenario<'_, 3>) -> VehicleState<3> {
     let st = sc.start_state(sc.default_initial_depth());
     let mut s = [TrackScore::default()];
     sc.simulate(&st, 0, &[866.86], &mut s, |_| {}).unwrap()
 }
 
 struct Track<'a, 'b> {
-    sc: &'a Scenario<'b, 3, 256, 8>,
+    sc: &'a Scenario<'b, 3>,
     st: &'a VehicleState<3>,
     evals: &'a Cell<u32>,
 }
 
 impl Objective<1> for Track<'_, '_> {
     type Error = auvnav::SimError;
-    fn eval(&mut self, z: &SVector<f32, 1>) -> Result<(f32, SVector<f32, 1>), Self::Error> {
+    fn eval(&mut self, z: &[f32; 1]) -> Result<(f32, [f32; 1]), Self::Error> {
         self.evals.set(self.evals.get() + 1);
-        let e = self.sc.evaluate::<1>(self.st, TRACK, &[z[0]])?;
-        Ok((e.j, SVector::<f32, 1>::new(e.grad_j[0])))
+        let e = self.sc.evaluate::<1>(self.st, TRACK, z)?;
+        Ok((e.j, e.grad_j))
     }
 }
 
@@ -140,7 +139,7 @@ fn tol() -> Tolerances {
 }
 
 /// Ours: (final J, evaluations).
-fn solve_ours(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) {
+fn solve_ours(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f32, u32) {
     let evals = Cell::new(0);
     let mut t = Track {
         sc,
@@ -151,12 +150,12 @@ fn solve_ours(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) 
         tol: tol(),
         ..BfgsConfig::default()
     };
-    let z0 = SVector::<f32, 1>::new(st.depth());
+    let z0 = [st.depth()];
     let out = optim::bfgs(&mut t, &z0, &Bounds::uniform(0.0, 6000.0), &cfg).unwrap();
     (out.j, evals.get())
 }
 
-fn solve_gd(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) {
+fn solve_gd(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f32, u32) {
     let evals = Cell::new(0);
     let mut t = Track {
         sc,
@@ -168,24 +167,24 @@ fn solve_gd(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) {
         max_iterations: 200,
         tol: tol(),
     };
-    let z0 = SVector::<f32, 1>::new(st.depth());
+    let z0 = [st.depth()];
     let out = optim::gradient_descent(&mut t, &z0, &Bounds::uniform(0.0, 6000.0), &cfg).unwrap();
     (out.j, evals.get())
 }
 
 /// argmin's BFGS (f64, More–Thuente), identity initial inverse Hessian.
-fn solve_argmin(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) {
+fn solve_argmin(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f32, u32) {
     solve_argmin_h0(sc, st, 1.0)
 }
 
 /// argmin's BFGS with our first-step scaling: `H0 = (10 m / ‖G0‖) I`.
-fn solve_argmin_scaled(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) {
+fn solve_argmin_scaled(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f32, u32) {
     let g0 = sc.evaluate::<1>(st, TRACK, &[st.depth()]).unwrap().grad_j[0];
     let (j, e) = solve_argmin_h0(sc, st, 10.0 / f64::from(g0.abs()));
     (j, e + 1)
 }
 
-fn solve_argmin_h0(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>, h0: f64) -> (f32, u32) {
+fn solve_argmin_h0(sc: &Scenario<'_, 3>, st: &VehicleState<3>, h0: f64) -> (f32, u32) {
     let evals = Cell::new(0);
     let t = Track {
         sc,
@@ -211,7 +210,7 @@ fn solve_argmin_h0(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>, h0: f64) 
 }
 
 /// numeris' no_std BFGS (f32; value and gradient are separate calls).
-fn solve_numeris(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> (f32, u32) {
+fn solve_numeris(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f32, u32) {
     let evals = Cell::new(0_u32);
     let f = |z: &numeris::Vector<f32, 1>| {
         evals.set(evals.get() + 1);

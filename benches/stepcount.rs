@@ -18,14 +18,14 @@ use auvnav::{Mission, Profile, Scenario, TrackScore, Vehicle, VehicleState, Wayp
 const PROFILE: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.csv");
 
 #[inline(never)]
-fn plain_track(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> VehicleState<3> {
+fn plain_track(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> VehicleState<3> {
     let mut s = [TrackScore::default()];
     sc.simulate(st, 1, &[black_box(680.0)], &mut s, |_| {})
         .unwrap()
 }
 
 #[inline(never)]
-fn gradient_track(sc: &Scenario<'_, 3, 256, 8>, st: &VehicleState<3>) -> f32 {
+fn gradient_track(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> f32 {
     sc.evaluate::<1>(st, 1, &[black_box(680.0)]).unwrap().grad_j[0]
 }
 

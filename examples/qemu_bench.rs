@@ -202,7 +202,11 @@ mod firmware {
             });
             let used = stack::used_below(base);
             let Ok(plan) = r else { exit(false) };
-            note_plan(id, &TrackPlan::of(&plan), &expected::TRACKWISE_K1[n]);
+            note_plan(
+                id,
+                &TrackPlan::of(&plan, &planner),
+                &expected::TRACKWISE_K1[n],
+            );
             hprintln!("stack|{}|{}", id, used);
             state = plan.next_state;
         }
@@ -225,7 +229,7 @@ mod firmware {
                 });
                 let used = stack::used_below(base);
                 let Ok(plan) = r else { exit(false) };
-                let p = TrackPlan::of(&plan);
+                let p = TrackPlan::of(&plan, &planner);
                 hprintln!(
                     "note|{}|track {} of {}, {} tracks jointly",
                     id,

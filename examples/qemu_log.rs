@@ -31,7 +31,7 @@ mod paper;
 
 #[cfg(target_os = "none")]
 mod firmware {
-    use auvnav::Plan;
+    use auvnav::{Plan, Planner};
     use cortex_m as _; // critical section for the defmt logger
     use cortex_m_rt::entry;
     use defmt_semihosting as _; // defmt frames to semihosting stdout
@@ -44,15 +44,15 @@ mod firmware {
         auvnav_qemu::exit(false)
     }
 
-    fn log_track<const K: usize>(mode: &str, track: usize, p: &Plan<3, K>) {
+    fn log_track<const K: usize>(mode: &str, track: usize, p: &Plan<3>, planner: &Planner<K>) {
         defmt::println!(
             "{=str} track {=usize}: {=usize} track(s) optimized jointly, {=usize} objective values",
             mode,
             track + 1,
             p.horizon_len,
-            p.history.len()
+            planner.history().len()
         );
-        for (i, j) in p.history.iter().enumerate() {
+        for (i, j) in planner.history().iter().enumerate() {
             defmt::println!("  iteration {=usize}: objective {=f32} m3", i, j);
         }
         defmt::println!(
@@ -76,8 +76,8 @@ mod firmware {
             monterey::SAMPLES,
             paper::TRACKS
         );
-        let plans = paper::plan_line::<1>(paper::trackwise_config(), |n, p| {
-            log_track("track-wise", n, p)
+        let plans = paper::plan_line::<1>(paper::trackwise_config(), |n, p, planner| {
+            log_track("track-wise", n, p, planner)
         });
         match plans {
             Ok(_) => {

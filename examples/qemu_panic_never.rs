@@ -72,7 +72,7 @@ mod firmware {
         // Every setting opaque to the optimizer: all of `plan` stays linked.
         let cfg = black_box(paper::trackwise_config());
         let base = stack::repaint();
-        let plans = paper::plan_line::<5>(cfg, |_, _| {});
+        let plans = paper::plan_line::<5>(cfg, |_, _, _| {});
         let used = stack::used_below(base);
         let Ok(plans) = plans else {
             print("qemu_panic_never: planning failed\n");

@@ -10,38 +10,51 @@
 //! `#![no_std]`, no allocation, no `unsafe`, no panics; f32 throughout, the
 //! same code on the host and on a Cortex-M4F.
 //!
-//! # The data flow, module by module
+//! # The data flow, folder by folder
 //!
-//! 1. [`profile`] — the bottom under the track: a bounded array of
-//!    along-track samples, linearly interpolated, never extrapolated.
-//! 2. [`plant`] and [`expm`] — the pitch transfer function `θ/δ` (or the
-//!    paper's `q/δ`), realized in controllable canonical form and discretized
-//!    by an exact zero-order hold computed in f32.
-//! 3. [`autopilot`] — the depth → pitch → elevator PID cascade, configuration
-//!    apart from state, usable as the real autopilot's loop.
-//! 4. [`vehicle`] — speed, sample time, plant and autopilot validated
-//!    together ([`Vehicle`]); the mission's altitudes and depth limits
+//! ```text
+//!  model/   profile, waypoints ─┐
+//!           plant (ZOH), autopilot, vehicle, mission
+//!              │
+//!  sim/     Scenario ─► run (one step in the contract's order) ─► score (J, V, h_min)
+//!              │                        └─► tangent (∂J/∂z, same pass)
+//!  optim/   GD, BFGS + Armijo, root search  (arrays in, arrays out)
+//!              │
+//!  plan/    Planner: box, scan, solve, verify, fallback ─► Plan (depth, status, …)
+//! ```
+//!
+//! 1. [`model`] — the vehicle and its world: the bottom under the track
+//!    ([`Profile`], never extrapolated), the line ([`Waypoints`]), the pitch
+//!    transfer function `θ/δ` (or the paper's `q/δ`) realized in
+//!    observability canonical form and discretized by an exact
+//!    zero-order hold computed in f32 ([`Plant`]), the depth → pitch →
+//!    elevator PID cascade ([`Autopilot`], usable as the real autopilot's
+//!    loop), validated together ([`Vehicle`]), and the mission's envelope
 //!    ([`Mission`]).
-//! 5. [`sim`] — a [`Scenario`] (vehicle, profile, [`Waypoints`], mission)
-//!    flies tracks from a [`VehicleState`], switching the reference at the
-//!    first sample past each waypoint, and scores each track as it goes:
+//! 2. [`sim`] — a [`Scenario`] (vehicle, profile, waypoints, mission) flies
+//!    tracks from a [`VehicleState`], switching the reference at the first
+//!    sample past each waypoint, and scores each track as it goes:
 //!    `J = ½ ∫ (d_t − d)² dx` by the clipped trapezoid rule, RMS deviation,
-//!    minimum altitude, violation of `h ≥ h_a` ([`TrackScore`]).
-//! 6. [`gradient`] — the same pass with tangent states gives the exact
-//!    gradient of `J` and of the violation with respect to the next `K`
-//!    reference depths ([`Evaluation`]).
-//! 7. [`optim`] — allocation-free gradient descent and dense BFGS with an
+//!    minimum altitude, violation of `h ≥ h_a` ([`TrackScore`]); the same
+//!    pass with tangent states gives their exact gradients with respect to
+//!    the next `K` reference depths ([`Evaluation`]).
+//! 3. [`optim`] — allocation-free gradient descent and dense BFGS with an
 //!    Armijo line search, on a box.
-//! 8. [`planner`] — the main entry point: a [`Planner`] takes the vehicle
+//! 4. [`plan`] — the main entry point: a [`Planner`] takes the vehicle
 //!    state at the start of the next track and returns that track's
 //!    reference depth ([`Plan`]), verified safe by simulation or flagged
 //!    [`PlanStatus::SafeFallback`] / [`PlanStatus::Infeasible`].
 //!
+//! The model's equations, units and step order are in the repository's
+//! `docs/model.md`, in this crate's words.
+//!
 //! Shapes are const generics: `N` the plant order capacity, `S` the profile
-//! capacity, `W` the waypoint capacity, `K` the number of depths optimized
-//! jointly. Values are validated at run time: every constructor returns a
-//! typed error ([`ProfileError`], [`PlantError`], [`ConfigError`],
-//! [`WaypointError`], [`SimError`], or the umbrella [`Error`]), and nothing
+//! capacity and `W` the waypoint capacity (erased once a [`Scenario`] is
+//! bound: it holds [`ProfileView`] and [`WaypointsView`]), `K` the number of
+//! depths optimized jointly. Values are validated at run time: every
+//! constructor returns a typed, `#[non_exhaustive]` error
+//! ([`ProfileError`], [`PlantError`], [`ConfigError`], [`WaypointError`],
+//! [`SimError`], [`PlanError`], or the umbrella [`Error`]), and nothing
 //! non-finite leaves the library.
 //!
 //! # Example
@@ -63,27 +76,24 @@
 #![no_std]
 #![cfg_attr(test, allow(clippy::float_cmp, clippy::arithmetic_side_effects))]
 
-pub mod autopilot;
 pub mod error;
-pub mod expm;
-pub mod gradient;
 mod log;
+pub mod model;
 mod num;
 pub mod optim;
-pub mod planner;
-pub mod plant;
-pub mod profile;
+pub mod plan;
 pub mod sim;
-pub mod vehicle;
 
-pub use autopilot::{Autopilot, AutopilotConfig, AutopilotState, Command, PidGains, PidTerms};
-pub use error::{ConfigError, Error};
-pub use gradient::Evaluation;
-pub use planner::{Method, Mode, Plan, PlanError, PlanStatus, Planner, PlannerConfig};
-pub use plant::{Plant, PlantError, TfKind, TransferFunction};
-pub use profile::{Profile, ProfileError};
-pub use sim::{Sample, Scenario, SimError, TrackScore, VehicleState, WaypointError, Waypoints};
-pub use vehicle::{MIN_STEP_LENGTH, Mission, Vehicle, VehicleConfig};
+pub use error::Error;
+pub use model::{
+    Autopilot, AutopilotConfig, AutopilotState, Command, ConfigError, MIN_STEP_LENGTH, Mission,
+    PidGains, PidTerms, Plant, PlantError, Profile, ProfileError, ProfileView, TfKind,
+    TransferFunction, Vehicle, VehicleConfig, WaypointError, Waypoints, WaypointsView,
+};
+pub use plan::{
+    Method, Mode, Plan, PlanConfigError, PlanError, PlanStatus, Planner, PlannerConfig,
+};
+pub use sim::{Evaluation, Sample, Scenario, SimError, TrackScore, VehicleState};
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -17,8 +17,6 @@
 use std::sync::mpsc;
 use std::time::Duration;
 
-use nalgebra::SVector;
-
 use auvnav::{
     AutopilotConfig, Mission, PidGains, PlanError, Planner, PlannerConfig, Profile, Scenario,
     SimError, TrackScore, TransferFunction, Vehicle, VehicleConfig, VehicleState, Waypoints,
@@ -195,7 +193,7 @@ fn telemetry_terms_stay_finite() {
         (line.start_state(420.0), -3e38),
         // A previous depth of -3e38 m: the D term.
         (
-            VehicleState::new(SVector::zeros(), 420.0, -3e38, 0.0, 0.0, 0.0, 0.0),
+            VehicleState::new([0.0; 3], 420.0, -3e38, 0.0, 0.0, 0.0, 0.0),
             420.0,
         ),
     ];

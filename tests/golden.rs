@@ -80,7 +80,7 @@ fn zoh_matches_scipy_cont2discrete() {
             want.push((dot(&cc, &x_ref), dot(&ca, &x_ref)));
             x_ref = (0..n).map(|i| dot(&ad_ref[i], &x_ref)).collect();
             x = (0..n)
-                .map(|i| (0..n).map(|j| f64::from(p.ad()[(i, j)]) * x[j]).sum())
+                .map(|i| (0..n).map(|j| f64::from(p.ad()[i][j]) * x[j]).sum())
                 .collect();
         }
         let scale =
@@ -202,7 +202,7 @@ fn step_responses_match_sample_by_sample() {
 /// start, via the library itself (the tracks before `n` are golden-checked
 /// by `line_scores_match`).
 fn state_at_track(
-    sc: &Scenario<'_, N, S, W>,
+    sc: &Scenario<'_, N>,
     start: &VehicleState<N>,
     depths: &[f32],
     n: usize,
@@ -217,7 +217,7 @@ fn state_at_track(
 
 /// Gradient of the total J and violation over all `K` tracks.
 fn horizon_gradient<const K: usize>(
-    sc: &Scenario<'_, N, S, W>,
+    sc: &Scenario<'_, N>,
     start: &VehicleState<N>,
     depths: &[f32],
 ) -> (Vec<f32>, Vec<f32>, f32) {

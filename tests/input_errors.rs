@@ -11,13 +11,12 @@
 )]
 #![allow(clippy::arithmetic_side_effects)]
 
-use auvnav::optim::{self, BfgsConfig, Bounds, OptimError};
+use auvnav::optim::{self, BfgsConfig, Bounds, OptimConfigError, OptimError};
 use auvnav::{
-    AutopilotConfig, ConfigError, Mission, PidGains, PlanError, Planner, PlannerConfig, PlantError,
-    Profile, ProfileError, Scenario, SimError, TfKind, TrackScore, TransferFunction, Vehicle,
-    VehicleConfig, VehicleState, WaypointError, Waypoints,
+    AutopilotConfig, ConfigError, Mission, PidGains, PlanConfigError, PlanError, Planner,
+    PlannerConfig, PlantError, Profile, ProfileError, Scenario, SimError, TfKind, TrackScore,
+    TransferFunction, Vehicle, VehicleConfig, VehicleState, WaypointError, Waypoints,
 };
-use nalgebra::SVector;
 
 const DEN: [f32; 4] = [1.0, 2.681, 0.546, 0.048];
 
@@ -426,7 +425,7 @@ fn planner_or_optimizer_setting_out_of_range() {
     let d = PlannerConfig::default();
     assert_eq!(
         Planner::<2>::new(PlannerConfig { gd_rate: -1.0, ..d }).unwrap_err(),
-        PlanError::Config("gd_rate")
+        PlanError::Config(PlanConfigError::Optimizer(OptimConfigError::GdRate))
     );
     assert_eq!(
         Planner::<2>::new(PlannerConfig {
@@ -434,21 +433,21 @@ fn planner_or_optimizer_setting_out_of_range() {
             ..d
         })
         .unwrap_err(),
-        PlanError::Config("penalty_stages")
+        PlanError::Config(PlanConfigError::PenaltyStages)
     );
     struct Q;
     impl optim::Objective<1> for Q {
         type Error = ();
-        fn eval(&mut self, z: &SVector<f32, 1>) -> Result<(f32, SVector<f32, 1>), ()> {
-            Ok((z[0] * z[0], SVector::<f32, 1>::new(2.0 * z[0])))
+        fn eval(&mut self, z: &[f32; 1]) -> Result<(f32, [f32; 1]), ()> {
+            Ok((z[0] * z[0], [2.0 * z[0]]))
         }
     }
     let mut cfg = BfgsConfig::default();
     cfg.armijo.shrink = 1.5;
-    let z = SVector::<f32, 1>::new(1.0);
+    let z = [1.0_f32];
     assert_eq!(
         optim::bfgs(&mut Q, &z, &Bounds::uniform(-2.0, 2.0), &cfg).unwrap_err(),
-        OptimError::Config("armijo.shrink")
+        OptimError::Config(OptimConfigError::ArmijoShrink)
     );
     assert_eq!(
         optim::bfgs(
@@ -458,7 +457,7 @@ fn planner_or_optimizer_setting_out_of_range() {
             &BfgsConfig::default()
         )
         .unwrap_err(),
-        OptimError::Config("bounds")
+        OptimError::Config(OptimConfigError::Bounds)
     );
 }
 
@@ -467,11 +466,11 @@ fn non_finite_objective_at_the_start() {
     struct Nan;
     impl optim::Objective<1> for Nan {
         type Error = ();
-        fn eval(&mut self, _: &SVector<f32, 1>) -> Result<(f32, SVector<f32, 1>), ()> {
-            Ok((f32::NAN, SVector::<f32, 1>::zeros()))
+        fn eval(&mut self, _: &[f32; 1]) -> Result<(f32, [f32; 1]), ()> {
+            Ok((f32::NAN, [0.0]))
         }
     }
-    let z = SVector::<f32, 1>::new(1.0);
+    let z = [1.0_f32];
     assert_eq!(
         optim::bfgs(
             &mut Nan,

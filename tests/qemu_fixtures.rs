@@ -124,7 +124,7 @@ mod checks {
                 let mut nx_ref = [0.0_f64; N];
                 for i in 0..n {
                     for j in 0..n {
-                        nx[i] += f64::from(p.ad()[(i, j)]) * x[j];
+                        nx[i] += f64::from(p.ad()[i][j]) * x[j];
                         nx_ref[i] += c.ad[i * n + j] * x_ref[j];
                     }
                 }
@@ -261,7 +261,7 @@ mod checks {
     /// State at the first sample of track `n` when flying `depths` from the
     /// start, via the library itself.
     fn state_at_track(
-        sc: &Scenario<'_, N, S, W>,
+        sc: &Scenario<'_, N>,
         start: &VehicleState<N>,
         depths: &[f32],
         n: usize,
@@ -279,7 +279,7 @@ mod checks {
 
     /// Gradient of the total J and violation over all `K` tracks.
     fn horizon_gradient<const K: usize>(
-        sc: &Scenario<'_, N, S, W>,
+        sc: &Scenario<'_, N>,
         start: &VehicleState<N>,
         depths: &[f32],
         gj: &mut [f32; W],

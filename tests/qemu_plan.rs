@@ -39,7 +39,7 @@ mod checks {
     /// Receding horizon, `Planner::<5>`, default configuration.
     pub fn horizon() -> [TrackPlan; paper::TRACKS] {
         ok!(
-            paper::plan_line::<5>(paper::horizon_config(), |_, _| {}),
+            paper::plan_line::<5>(paper::horizon_config(), |_, _, _| {}),
             "horizon planning failed"
         )
     }
@@ -47,7 +47,7 @@ mod checks {
     /// Track-wise, `Planner::<1>`.
     pub fn trackwise() -> [TrackPlan; paper::TRACKS] {
         ok!(
-            paper::plan_line::<1>(paper::trackwise_config(), |_, _| {}),
+            paper::plan_line::<1>(paper::trackwise_config(), |_, _, _| {}),
             "track-wise planning failed"
         )
     }

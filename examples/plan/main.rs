@@ -178,7 +178,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
 fn plan_line(
     args: &Args,
     cfg: &input::Config,
-    scenario: &Scenario<'_, { input::ORDER }, SAMPLES, WAYPOINTS>,
+    scenario: &Scenario<'_, { input::ORDER }>,
     initial_depth: f32,
 ) -> Result<Plan, Fail> {
     let pc = PlannerConfig {
@@ -209,7 +209,7 @@ fn plan_line(
             iterations: p.iterations,
             evaluations: p.evaluations,
             status: p.status.as_str(),
-            j_history: p.history.to_vec(),
+            j_history: planner.history().to_vec(),
         });
         state = p.next_state;
     }

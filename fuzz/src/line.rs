@@ -546,7 +546,7 @@ impl<const N: usize> Line<N> {
 
     /// The scenario, or `None` when a waypoint lies outside the profile
     /// (checked to be the only reason).
-    pub fn scenario(&self) -> Option<Scenario<'_, N, SAMPLES, WAYPOINTS>> {
+    pub fn scenario(&self) -> Option<Scenario<'_, N>> {
         let sc = Scenario::new(&self.vehicle, &self.profile, &self.waypoints, self.mission);
         let inside = self
             .waypoints

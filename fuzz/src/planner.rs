@@ -202,7 +202,7 @@ fn with_line<const N: usize>(vehicle: auvnav::Vehicle<N>, input: &Input) -> Outc
 }
 
 fn plan_line<const N: usize, const K: usize>(
-    sc: &Scenario<'_, N, SAMPLES, WAYPOINTS>,
+    sc: &Scenario<'_, N>,
     line: &Line<N>,
     cfg: PlannerConfig,
     input: &Input,
@@ -271,7 +271,7 @@ fn plan_line<const N: usize, const K: usize>(
 /// The error the simulation gives for `state` on `track`, when it is not
 /// a state to fly that track from (not finite, or not on the track).
 fn bad_start<const N: usize>(
-    sc: &Scenario<'_, N, SAMPLES, WAYPOINTS>,
+    sc: &Scenario<'_, N>,
     state: &VehicleState<N>,
     track: usize,
 ) -> Option<SimError> {
@@ -289,7 +289,7 @@ fn bad_start<const N: usize>(
 /// The contract of one plan (`physical`: the input's magnitudes are, see
 /// [`crate::known`]).
 pub fn check<const N: usize, const K: usize>(
-    sc: &Scenario<'_, N, SAMPLES, WAYPOINTS>,
+    sc: &Scenario<'_, N>,
     cfg: &PlannerConfig,
     state: &VehicleState<N>,
     track: usize,
@@ -330,7 +330,7 @@ fn check_finite<const N: usize, const K: usize>(track: usize, plan: &Plan<N, K>)
 }
 
 fn check_contract<const N: usize, const K: usize>(
-    sc: &Scenario<'_, N, SAMPLES, WAYPOINTS>,
+    sc: &Scenario<'_, N>,
     cfg: &PlannerConfig,
     state: &VehicleState<N>,
     track: usize,

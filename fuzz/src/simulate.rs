@@ -109,7 +109,7 @@ fn with_line<const N: usize>(vehicle: auvnav::Vehicle<N>, input: &Input) -> Outc
 /// Both passes over `count` tracks from `first`, checked (`physical`: the
 /// input's magnitudes are, see [`crate::known`]).
 pub fn fly<const N: usize>(
-    sc: &Scenario<'_, N, SAMPLES, WAYPOINTS>,
+    sc: &Scenario<'_, N>,
     start: &VehicleState<N>,
     first: usize,
     depths: &[f32; 3],

@@ -21,23 +21,21 @@
 //! evaluation fails (a diverging simulation) or is not finite counts as
 //! not decreasing, and the step shrinks.
 
-use nalgebra::SVector;
-
-use super::{Bounds, Objective};
+use super::{Bounds, Objective, OptimConfigError, Vector, dot, eval};
 
 /// An accepted trial point.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Trial<const K: usize> {
+pub(crate) struct Trial<const K: usize> {
     /// The point `z_t`.
-    pub z: SVector<f32, K>,
+    pub z: Vector<K>,
     /// Objective there.
     pub j: f32,
     /// Gradient there.
-    pub g: SVector<f32, K>,
+    pub g: Vector<K>,
 }
 
 /// A line search: finds an acceptable point along a direction.
-pub trait LineSearch<const K: usize> {
+pub(crate) trait LineSearch<const K: usize> {
     /// Searches from `z` (objective `j`, gradient `g`) along `dir`, counting
     /// evaluations into `evals`. `None` when no acceptable point was found.
     #[allow(clippy::too_many_arguments)]
@@ -45,10 +43,10 @@ pub trait LineSearch<const K: usize> {
         &self,
         obj: &mut O,
         bounds: &Bounds<K>,
-        z: &SVector<f32, K>,
+        z: &Vector<K>,
         j: f32,
-        g: &SVector<f32, K>,
-        dir: &SVector<f32, K>,
+        g: &Vector<K>,
+        dir: &Vector<K>,
         evals: &mut u32,
     ) -> Option<Trial<K>>;
 }
@@ -84,17 +82,19 @@ impl Default for Armijo {
 }
 
 impl Armijo {
-    /// `Ok` when every setting is in range, else the name of the first
-    /// that is not.
-    pub fn validate(&self) -> Result<(), &'static str> {
+    /// `Ok` when every setting is in range, else the first that is not.
+    ///
+    /// # Errors
+    /// [`OptimConfigError`] naming it.
+    pub fn validate(&self) -> Result<(), OptimConfigError> {
         if !(self.c1 > 0.0 && self.c1 < 1.0) {
-            return Err("armijo.c1");
+            return Err(OptimConfigError::ArmijoC1);
         }
         if !(self.shrink > 0.0 && self.shrink < 1.0) {
-            return Err("armijo.shrink");
+            return Err(OptimConfigError::ArmijoShrink);
         }
         if self.max_backtracks == 0 {
-            return Err("armijo.max_backtracks");
+            return Err(OptimConfigError::ArmijoBacktracks);
         }
         Ok(())
     }
@@ -128,24 +128,24 @@ impl<const K: usize> LineSearch<K> for Armijo {
         &self,
         obj: &mut O,
         bounds: &Bounds<K>,
-        z: &SVector<f32, K>,
+        z: &Vector<K>,
         j: f32,
-        g: &SVector<f32, K>,
-        dir: &SVector<f32, K>,
+        g: &Vector<K>,
+        dir: &Vector<K>,
         evals: &mut u32,
     ) -> Option<Trial<K>> {
         let mut alpha = 1.0_f32;
         for _ in 0..=self.max_backtracks {
-            let zt = bounds.project(&(z + dir * alpha));
+            let zt = bounds.project_v(&(z + dir * alpha));
             let step = zt - z;
-            let slope = g.dot(&step);
+            let slope = dot(g, &step);
             // A vanished step (pinned by the box, or α underflowed) or a
             // projected step that no longer descends: nothing to gain.
             if step.iter().all(|&v| v == 0.0) || slope >= 0.0 {
                 return None;
             }
             *evals = evals.saturating_add(1);
-            let jt = match obj.eval(&zt) {
+            let jt = match eval(obj, &zt) {
                 Ok((jt, gt)) if jt.is_finite() && gt.iter().all(|v| v.is_finite()) => {
                     if self.accepts(j, jt, slope) {
                         return Some(Trial {
@@ -167,6 +167,7 @@ impl<const K: usize> LineSearch<K> for Armijo {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::SVector;
 
     #[test]
     fn accepts_and_rejects_exactly_at_the_boundary() {
@@ -190,8 +191,8 @@ mod tests {
         struct Sq;
         impl Objective<1> for Sq {
             type Error = ();
-            fn eval(&mut self, z: &SVector<f32, 1>) -> Result<(f32, SVector<f32, 1>), ()> {
-                Ok((z[0] * z[0], SVector::<f32, 1>::new(2.0 * z[0])))
+            fn eval(&mut self, z: &[f32; 1]) -> Result<(f32, [f32; 1]), ()> {
+                Ok((z[0] * z[0], [2.0 * z[0]]))
             }
         }
         let b = Bounds::<1>::uniform(-10.0, 10.0);
@@ -211,9 +212,9 @@ mod tests {
         struct Quartic;
         impl Objective<1> for Quartic {
             type Error = ();
-            fn eval(&mut self, z: &SVector<f32, 1>) -> Result<(f32, SVector<f32, 1>), ()> {
+            fn eval(&mut self, z: &[f32; 1]) -> Result<(f32, [f32; 1]), ()> {
                 let v = z[0];
-                Ok((v * v * v * v, SVector::<f32, 1>::new(4.0 * v * v * v)))
+                Ok((v * v * v * v, [4.0 * v * v * v]))
             }
         }
         let b = Bounds::<1>::uniform(-100.0, 100.0);
@@ -240,8 +241,8 @@ mod tests {
         struct Up;
         impl Objective<1> for Up {
             type Error = ();
-            fn eval(&mut self, _: &SVector<f32, 1>) -> Result<(f32, SVector<f32, 1>), ()> {
-                Ok((5.0, SVector::<f32, 1>::new(1.0)))
+            fn eval(&mut self, _: &[f32; 1]) -> Result<(f32, [f32; 1]), ()> {
+                Ok((5.0, [1.0]))
             }
         }
         let a = Armijo {
@@ -271,10 +272,10 @@ mod tests {
             }
             .validate()
         };
-        assert_eq!(bad(0.0, 0.5, 3), Err("armijo.c1"));
-        assert_eq!(bad(1.0, 0.5, 3), Err("armijo.c1"));
-        assert_eq!(bad(f32::NAN, 0.5, 3), Err("armijo.c1"));
-        assert_eq!(bad(0.1, 1.0, 3), Err("armijo.shrink"));
-        assert_eq!(bad(0.1, 0.5, 0), Err("armijo.max_backtracks"));
+        assert_eq!(bad(0.0, 0.5, 3), Err(OptimConfigError::ArmijoC1));
+        assert_eq!(bad(1.0, 0.5, 3), Err(OptimConfigError::ArmijoC1));
+        assert_eq!(bad(f32::NAN, 0.5, 3), Err(OptimConfigError::ArmijoC1));
+        assert_eq!(bad(0.1, 1.0, 3), Err(OptimConfigError::ArmijoShrink));
+        assert_eq!(bad(0.1, 0.5, 0), Err(OptimConfigError::ArmijoBacktracks));
     }
 }

@@ -32,10 +32,11 @@
 //!   direction (only possible through rounding), `A` is reset to the
 //!   scaled identity.
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SMatrix;
 
 use super::{
-    Armijo, Bounds, LineSearch, Objective, OptimError, Outcome, Status, Tolerances, start,
+    Armijo, Bounds, LineSearch, Objective, OptimConfigError, OptimError, Outcome, Status,
+    Tolerances, Vector, dot, norm, start,
 };
 
 /// Relative tolerance of the curvature guard (see the module docs).
@@ -70,20 +71,22 @@ impl Default for BfgsConfig {
 }
 
 impl BfgsConfig {
-    /// `Ok` when every setting is in range, else the name of the first
-    /// that is not.
-    pub fn validate(&self) -> Result<(), &'static str> {
+    /// `Ok` when every setting is in range, else the first that is not.
+    ///
+    /// # Errors
+    /// [`OptimConfigError`] naming it.
+    pub fn validate(&self) -> Result<(), OptimConfigError> {
         if self.max_iterations == 0 {
-            return Err("max_iterations");
+            return Err(OptimConfigError::MaxIterations);
         }
         if !(self.first_step.is_finite() && self.first_step > 0.0) {
-            return Err("first_step");
+            return Err(OptimConfigError::FirstStep);
         }
         if !(self.max_step.is_finite() && self.max_step > 0.0) {
-            return Err("max_step");
+            return Err(OptimConfigError::MaxStep);
         }
         if !self.tol.is_valid() {
-            return Err("tolerances");
+            return Err(OptimConfigError::Tolerances);
         }
         self.armijo.validate()
     }
@@ -97,41 +100,21 @@ impl BfgsConfig {
 /// objective fails or is not finite at the (projected) start.
 pub fn bfgs<const K: usize, O: Objective<K>>(
     obj: &mut O,
-    z0: &SVector<f32, K>,
+    z0: &[f32; K],
     bounds: &Bounds<K>,
     cfg: &BfgsConfig,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
-    bfgs_with(obj, z0, bounds, cfg, &cfg.armijo)
+    bfgs_from(obj, z0, bounds, cfg, &[0.0; K])
 }
 
 /// [`bfgs`] with another line search (tests use an exact one).
-///
-/// # Errors
-/// As [`bfgs`].
-pub fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
+#[cfg(test)]
+pub(crate) fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     obj: &mut O,
-    z0: &SVector<f32, K>,
+    z0: &[f32; K],
     bounds: &Bounds<K>,
     cfg: &BfgsConfig,
     line_search: &L,
-) -> Result<Outcome<K>, OptimError<O::Error>> {
-    bfgs_from(obj, z0, bounds, cfg, line_search, &SVector::zeros())
-}
-
-/// [`bfgs_with`] from a known diagonal curvature: `A_0 = diag(curvature)`
-/// where an entry is positive (m³/m², e.g. from a parabola through scanned
-/// values), the first-step scaling elsewhere. An informed metric is not
-/// rescaled before the first update.
-///
-/// # Errors
-/// As [`bfgs`].
-pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
-    obj: &mut O,
-    z0: &SVector<f32, K>,
-    bounds: &Bounds<K>,
-    cfg: &BfgsConfig,
-    line_search: &L,
-    curvature: &SVector<f32, K>,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
     let mut out = Outcome::at(z0);
     bfgs_into(
@@ -140,6 +123,34 @@ pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         bounds,
         cfg,
         line_search,
+        &[0.0; K],
+        &mut out,
+        false,
+    )?;
+    Ok(out)
+}
+
+/// [`bfgs`] from a known diagonal curvature: `A_0 = diag(curvature)`
+/// where an entry is positive (m³/m², e.g. from a parabola through scanned
+/// values), the first-step scaling elsewhere. An informed metric is not
+/// rescaled before the first update.
+///
+/// # Errors
+/// As [`bfgs`].
+pub fn bfgs_from<const K: usize, O: Objective<K>>(
+    obj: &mut O,
+    z0: &[f32; K],
+    bounds: &Bounds<K>,
+    cfg: &BfgsConfig,
+    curvature: &[f32; K],
+) -> Result<Outcome<K>, OptimError<O::Error>> {
+    let mut out = Outcome::at(z0);
+    bfgs_into(
+        obj,
+        z0,
+        bounds,
+        cfg,
+        &cfg.armijo,
         curvature,
         &mut out,
         false,
@@ -154,20 +165,21 @@ pub fn bfgs_from<const K: usize, O: Objective<K>, L: LineSearch<K>>(
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     obj: &mut O,
-    z0: &SVector<f32, K>,
+    z0: &[f32; K],
     bounds: &Bounds<K>,
     cfg: &BfgsConfig,
     line_search: &L,
-    curvature: &SVector<f32, K>,
+    curvature: &[f32; K],
     out: &mut Outcome<K>,
     continued: bool,
 ) -> Result<(), OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
+    let curvature = Vector::from(*curvature);
     let informed = curvature.iter().any(|&c| c.is_finite() && c > 0.0);
     if !bounds.is_valid() {
-        return Err(OptimError::Config("bounds"));
+        return Err(OptimError::Config(OptimConfigError::Bounds));
     }
-    let mut z = bounds.project(z0);
+    let mut z = bounds.project_v(&Vector::from(*z0));
     let (mut j, mut g) = start(obj, &z)?;
     let mut evaluations = 1_u32;
     let history = &mut out.history;
@@ -180,7 +192,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut iterations = 0_u32;
 
     let status = loop {
-        let grad_norm = bounds.free_gradient_norm(&z, &g);
+        let grad_norm = bounds.free_gradient_norm_v(&z, &g);
         // Stopping rule 3.14a.
         if grad_norm <= cfg.tol.grad {
             break Status::Converged;
@@ -214,7 +226,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         };
         // Model-predicted decrease below the 3.14b threshold: converged
         // without spending an evaluation on a step that cannot matter.
-        if -0.5 * g.dot(&dir) <= cfg.tol.j_threshold(j) {
+        if -0.5 * dot(&g, &dir) <= cfg.tol.j_threshold(j) {
             break Status::Converged;
         }
         let Some(t) = line_search.search(obj, bounds, &z, j, &g, &dir, &mut evaluations) else {
@@ -222,11 +234,11 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         };
         let dz = t.z - z;
         let y = t.g - g;
-        let yd = y.dot(&dz);
+        let yd = dot(&y, &dz);
         // Curvature guard: only a positive Yᵀ Δζ keeps A positive definite.
-        if yd > CURVATURE_TOL * y.norm() * dz.norm() {
+        if yd > CURVATURE_TOL * norm(&y) * norm(&dz) {
             if !rescaled {
-                *a = SMatrix::identity() * (y.dot(&y) / yd);
+                *a = SMatrix::identity() * (dot(&y, &y) / yd);
                 rescaled = true;
             }
             update(a, &dz, &y, yd);
@@ -243,8 +255,8 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             "bfgs iteration {=u32}: J {=f32} m3, |G| {=f32} m2, step {=f32} m, evaluations {=u32}",
             iterations,
             j,
-            g.norm(),
-            dz.norm(),
+            norm(&g),
+            norm(&dz),
             evaluations
         );
         // Stopping rule 3.14b.
@@ -252,10 +264,10 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             break Status::Converged;
         }
     };
-    out.grad_norm = bounds.free_gradient_norm(&z, &g);
-    out.z = z;
+    out.grad_norm = bounds.free_gradient_norm_v(&z, &g);
+    out.z = z.into();
     out.j = j;
-    out.gradient = g;
+    out.gradient = g.into();
     out.status = status;
     out.iterations = iterations;
     out.evaluations = evaluations;
@@ -265,14 +277,9 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
 
 /// The BFGS update of `a` for step `dz` and gradient change `y`
 /// (`yd = yᵀ dz > 0`), in the general form (see the module docs).
-fn update<const K: usize>(
-    a: &mut SMatrix<f32, K, K>,
-    dz: &SVector<f32, K>,
-    y: &SVector<f32, K>,
-    yd: f32,
-) {
+fn update<const K: usize>(a: &mut SMatrix<f32, K, K>, dz: &Vector<K>, y: &Vector<K>, yd: f32) {
     let ad = *a * dz;
-    let dad = dz.dot(&ad);
+    let dad = dot(dz, &ad);
     if dad > 0.0 {
         *a += y * (y.transpose() / yd) - ad * (ad.transpose() / dad);
         // Keep it exactly symmetric against rounding.
@@ -286,9 +293,9 @@ fn update<const K: usize>(
 fn direction<const K: usize>(
     a: &SMatrix<f32, K, K>,
     bounds: &Bounds<K>,
-    z: &SVector<f32, K>,
-    g: &SVector<f32, K>,
-) -> Option<SVector<f32, K>> {
+    z: &Vector<K>,
+    g: &Vector<K>,
+) -> Option<Vector<K>> {
     let mut m = *a;
     let mut rhs = -g;
     let mut any_free = false;
@@ -297,7 +304,7 @@ fn direction<const K: usize>(
             any_free = true;
         } else {
             m.set_row(i, &nalgebra::RowSVector::zeros());
-            m.set_column(i, &SVector::zeros());
+            m.set_column(i, &Vector::zeros());
             if let Some(v) = m.get_mut((i, i)) {
                 *v = 1.0;
             }
@@ -310,15 +317,15 @@ fn direction<const K: usize>(
         return None;
     }
     let s = m.cholesky()?.solve(&rhs);
-    (s.iter().all(|v| v.is_finite()) && g.dot(&s) < 0.0).then_some(s)
+    (s.iter().all(|v| v.is_finite()) && dot(g, &s) < 0.0).then_some(s)
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::armijo::{LineSearch, Trial};
     use super::super::testfns::{Quadratic, Rosenbrock};
-    use super::super::{Trial, armijo::LineSearch};
     use super::*;
-    use nalgebra::{Matrix3, Vector2, Vector3};
+    use nalgebra::{Matrix3, SVector, Vector3};
 
     #[test]
     fn rosenbrock_from_the_classic_start() {
@@ -332,13 +339,7 @@ mod tests {
             },
             ..BfgsConfig::default()
         };
-        let out = bfgs(
-            &mut f,
-            &Vector2::new(-1.2, 1.0),
-            &Bounds::uniform(-5.0, 5.0),
-            &cfg,
-        )
-        .unwrap();
+        let out = bfgs(&mut f, &[-1.2, 1.0], &Bounds::uniform(-5.0, 5.0), &cfg).unwrap();
         assert!((out.z[0] - 1.0).abs() < 1e-4, "{out:?}");
         assert!((out.z[1] - 1.0).abs() < 1e-4, "{out:?}");
         assert!(out.iterations < 100, "{}", out.iterations);
@@ -352,17 +353,21 @@ mod tests {
             &self,
             obj: &mut O,
             _: &Bounds<3>,
-            z: &SVector<f32, 3>,
+            z: &Vector<3>,
             _: f32,
-            g: &SVector<f32, 3>,
-            dir: &SVector<f32, 3>,
+            g: &Vector<3>,
+            dir: &Vector<3>,
             evals: &mut u32,
         ) -> Option<Trial<3>> {
             let alpha = -g.dot(dir) / dir.dot(&(self.0 * dir));
             let zt = z + dir * alpha;
             *evals += 1;
-            let (j, g) = obj.eval(&zt).ok()?;
-            Some(Trial { z: zt, j, g })
+            let (j, g) = obj.eval(&zt.into()).ok()?;
+            Some(Trial {
+                z: zt,
+                j,
+                g: SVector::from(g),
+            })
         }
     }
 
@@ -383,7 +388,7 @@ mod tests {
         };
         let out = bfgs_with(
             &mut q,
-            &Vector3::zeros(),
+            &[0.0; 3],
             &Bounds::uniform(-100.0, 100.0),
             &cfg,
             &Exact(h),
@@ -391,7 +396,8 @@ mod tests {
         .unwrap();
         assert_eq!(out.status, Status::Converged);
         assert!(out.iterations <= 4, "{} iterations", out.iterations);
-        assert!((out.z - want).amax() < 1e-4, "{} vs {want}", out.z);
+        let z = SVector::from(out.z);
+        assert!((z - want).amax() < 1e-4, "{z} vs {want}");
     }
 
     #[test]
@@ -456,20 +462,14 @@ mod tests {
         let b = Vector3::new(1.0, -2.0, 3.0);
         let mut q = Quadratic { h, b };
         let bounds = Bounds {
-            lo: Vector3::new(-10.0, -1.0, 3.0),
-            hi: Vector3::new(0.0, 10.0, 3.0),
+            lo: [-10.0, -1.0, 3.0],
+            hi: [0.0, 10.0, 3.0],
         };
-        let out = bfgs(
-            &mut q,
-            &Vector3::new(-5.0, 5.0, 3.0),
-            &bounds,
-            &BfgsConfig::default(),
-        )
-        .unwrap();
+        let out = bfgs(&mut q, &[-5.0, 5.0, 3.0], &bounds, &BfgsConfig::default()).unwrap();
         assert_eq!(out.status, Status::Converged);
         assert!(
-            (out.z - Vector3::new(0.0, -1.0, 3.0)).amax() < 1e-3,
-            "{}",
+            (SVector::from(out.z) - Vector3::new(0.0, -1.0, 3.0)).amax() < 1e-3,
+            "{:?}",
             out.z
         );
     }
@@ -482,13 +482,13 @@ mod tests {
         struct Spy(Quadratic<3>, heapless::Vec<f32, 64>);
         impl Objective<3> for Spy {
             type Error = ();
-            fn eval(&mut self, z: &SVector<f32, 3>) -> Result<(f32, SVector<f32, 3>), ()> {
-                let _ = self.1.push(z.norm());
+            fn eval(&mut self, z: &[f32; 3]) -> Result<(f32, [f32; 3]), ()> {
+                let _ = self.1.push(SVector::from(*z).norm());
                 self.0.eval(z)
             }
         }
         let mut spy = Spy(Quadratic { h, b }, heapless::Vec::new());
-        let z0 = Vector3::new(200.0, 0.0, 0.0);
+        let z0 = [200.0, 0.0, 0.0];
         let cfg = BfgsConfig::default();
         bfgs(&mut spy, &z0, &Bounds::uniform(-1e4, 1e4), &cfg).unwrap();
         // The first trial moved exactly first_step = 10 m.
@@ -501,7 +501,7 @@ mod tests {
             h: Matrix3::identity(),
             b: Vector3::zeros(),
         };
-        let z = Vector3::zeros();
+        let z = [0.0; 3];
         let b = Bounds::uniform(-1.0, 1.0);
         let cfg = BfgsConfig {
             max_iterations: 0,
@@ -509,7 +509,7 @@ mod tests {
         };
         assert_eq!(
             bfgs(&mut q, &z, &b, &cfg).unwrap_err(),
-            OptimError::Config("max_iterations")
+            OptimError::Config(OptimConfigError::MaxIterations)
         );
         let cfg = BfgsConfig {
             first_step: f32::NAN,
@@ -517,12 +517,12 @@ mod tests {
         };
         assert_eq!(
             bfgs(&mut q, &z, &b, &cfg).unwrap_err(),
-            OptimError::Config("first_step")
+            OptimError::Config(OptimConfigError::FirstStep)
         );
         let bad = Bounds::uniform(1.0, -1.0);
         assert_eq!(
             bfgs(&mut q, &z, &bad, &BfgsConfig::default()).unwrap_err(),
-            OptimError::Config("bounds")
+            OptimError::Config(OptimConfigError::Bounds)
         );
     }
 }

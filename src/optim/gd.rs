@@ -3,9 +3,10 @@
 //! convergence depends entirely on `κ`, which is the point of comparing it
 //! with BFGS.
 
-use nalgebra::SVector;
-
-use super::{Bounds, Objective, OptimError, Outcome, Status, Tolerances, start};
+use super::{
+    Bounds, Objective, OptimConfigError, OptimError, Outcome, Status, Tolerances, Vector, eval,
+    norm, start,
+};
 
 /// Gradient-descent settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,16 +21,19 @@ pub struct GdConfig {
 }
 
 impl GdConfig {
-    /// `Ok` when every setting is in range, else its name.
-    pub fn validate(&self) -> Result<(), &'static str> {
+    /// `Ok` when every setting is in range, else the first that is not.
+    ///
+    /// # Errors
+    /// [`OptimConfigError`] naming it.
+    pub fn validate(&self) -> Result<(), OptimConfigError> {
         if !(self.rate.is_finite() && self.rate > 0.0) {
-            return Err("gd_rate");
+            return Err(OptimConfigError::GdRate);
         }
         if self.max_iterations == 0 {
-            return Err("max_iterations");
+            return Err(OptimConfigError::MaxIterations);
         }
         if !self.tol.is_valid() {
-            return Err("tolerances");
+            return Err(OptimConfigError::Tolerances);
         }
         Ok(())
     }
@@ -43,7 +47,7 @@ impl GdConfig {
 /// [`OptimError`] for an invalid configuration or box, or a failed start.
 pub fn gradient_descent<const K: usize, O: Objective<K>>(
     obj: &mut O,
-    z0: &SVector<f32, K>,
+    z0: &[f32; K],
     bounds: &Bounds<K>,
     cfg: &GdConfig,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
@@ -56,7 +60,7 @@ pub fn gradient_descent<const K: usize, O: Objective<K>>(
 /// `bfgs::bfgs_into`).
 pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
     obj: &mut O,
-    z0: &SVector<f32, K>,
+    z0: &[f32; K],
     bounds: &Bounds<K>,
     cfg: &GdConfig,
     out: &mut Outcome<K>,
@@ -64,9 +68,9 @@ pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
 ) -> Result<(), OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
     if !bounds.is_valid() {
-        return Err(OptimError::Config("bounds"));
+        return Err(OptimError::Config(OptimConfigError::Bounds));
     }
-    let mut z = bounds.project(z0);
+    let mut z = bounds.project_v(&Vector::from(*z0));
     let (mut j, mut g) = start(obj, &z)?;
     let mut evaluations = 1_u32;
     let history = &mut out.history;
@@ -75,19 +79,19 @@ pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
     }
     let mut iterations = 0_u32;
     let status = loop {
-        if bounds.free_gradient_norm(&z, &g) <= cfg.tol.grad {
+        if bounds.free_gradient_norm_v(&z, &g) <= cfg.tol.grad {
             break Status::Converged;
         }
         if iterations >= cfg.max_iterations {
             break Status::MaxIterations;
         }
-        let zt = bounds.project(&(z - g * cfg.rate));
+        let zt = bounds.project_v(&(z - g * cfg.rate));
         if zt == z {
             // Pinned against the box: no move left.
             break Status::Converged;
         }
         evaluations = evaluations.saturating_add(1);
-        let (jt, gt) = match obj.eval(&zt) {
+        let (jt, gt) = match eval(obj, &zt) {
             Ok((jt, gt)) if jt.is_finite() && gt.iter().all(|v| v.is_finite()) => (jt, gt),
             _ => break Status::LineSearchFailed,
         };
@@ -101,16 +105,16 @@ pub(crate) fn gradient_descent_into<const K: usize, O: Objective<K>>(
             "gd iteration {=u32}: J {=f32} m3, |G| {=f32} m2",
             iterations,
             j,
-            g.norm()
+            norm(&g)
         );
         if libm::fabsf(dj) <= cfg.tol.j_threshold(j) {
             break Status::Converged;
         }
     };
-    out.grad_norm = bounds.free_gradient_norm(&z, &g);
-    out.z = z;
+    out.grad_norm = bounds.free_gradient_norm_v(&z, &g);
+    out.z = z.into();
     out.j = j;
-    out.gradient = g;
+    out.gradient = g.into();
     out.status = status;
     out.iterations = iterations;
     out.evaluations = evaluations;
@@ -140,15 +144,10 @@ mod tests {
             },
         };
         // Minimum value 0 at the origin, so f32 resolves J all the way.
-        let out = gradient_descent(
-            &mut q,
-            &Vector2::new(-1.0, -2.0),
-            &Bounds::uniform(-9.0, 9.0),
-            &cfg,
-        )
-        .unwrap();
+        let out =
+            gradient_descent(&mut q, &[-1.0, -2.0], &Bounds::uniform(-9.0, 9.0), &cfg).unwrap();
         assert_eq!(out.status, Status::Converged);
-        assert!(out.z.amax() < 1e-4, "{}", out.z);
+        assert!(out.z.iter().all(|v| v.abs() < 1e-4), "{:?}", out.z);
         // The slow mode contracts by 1 - 0.4 * 0.5 = 0.8 per iteration.
         assert!(out.iterations > 40, "{}", out.iterations);
         assert_eq!(out.evaluations, out.iterations + 1);
@@ -167,9 +166,8 @@ mod tests {
             tol: Tolerances::default(),
         };
         assert_eq!(
-            gradient_descent(&mut q, &Vector2::zeros(), &Bounds::uniform(-1.0, 1.0), &cfg)
-                .unwrap_err(),
-            OptimError::Config("gd_rate")
+            gradient_descent(&mut q, &[0.0; 2], &Bounds::uniform(-1.0, 1.0), &cfg).unwrap_err(),
+            OptimError::Config(OptimConfigError::GdRate)
         );
     }
 }

@@ -14,13 +14,15 @@
 pub mod armijo;
 pub mod bfgs;
 pub mod gd;
+pub(crate) mod root;
 
 use core::fmt;
 
 use heapless::Vec;
 use nalgebra::SVector;
 
-pub use armijo::{Armijo, LineSearch, Trial};
+pub use armijo::Armijo;
+pub(crate) use armijo::LineSearch;
 pub use bfgs::{BfgsConfig, bfgs, bfgs_from};
 pub use gd::{GdConfig, gradient_descent};
 
@@ -36,36 +38,72 @@ pub trait Objective<const K: usize> {
     /// # Errors
     /// When the function cannot be evaluated at `z` (for the planner: the
     /// simulation diverged).
-    fn eval(&mut self, z: &SVector<f32, K>) -> Result<(f32, SVector<f32, K>), Self::Error>;
+    fn eval(&mut self, z: &[f32; K]) -> Result<(f32, [f32; K]), Self::Error>;
+}
+
+/// The optimizers' internal vector type; plain arrays at the boundary.
+pub(crate) type Vector<const K: usize> = SVector<f32, K>;
+
+/// [`Objective::eval`] on the internal vector type.
+pub(crate) fn eval<const K: usize, O: Objective<K>>(
+    obj: &mut O,
+    z: &Vector<K>,
+) -> Result<(f32, Vector<K>), O::Error> {
+    let (j, g) = obj.eval(&(*z).into())?;
+    Ok((j, Vector::from(g)))
+}
+
+/// `aᵀb`, summed in index order whatever `K`: a dimension-independent
+/// result (nalgebra unrolls dot products of eight or more entries into
+/// partial sums, so a problem padded to a larger `K` would round
+/// differently).
+pub(crate) fn dot<const K: usize>(a: &Vector<K>, b: &Vector<K>) -> f32 {
+    a.iter().zip(b.iter()).fold(0.0, |s, (x, y)| s + x * y)
+}
+
+/// `‖a‖₂`, as [`dot`].
+pub(crate) fn norm<const K: usize>(a: &Vector<K>) -> f32 {
+    libm::sqrtf(dot(a, a))
 }
 
 /// Box constraint `lo <= z <= hi`, enforced by projection (clamping) of
 /// every trial point. A variable with `lo == hi` is pinned.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Bounds<const K: usize> {
     /// Lower bounds.
-    pub lo: SVector<f32, K>,
+    pub lo: [f32; K],
     /// Upper bounds.
-    pub hi: SVector<f32, K>,
+    pub hi: [f32; K],
 }
 
 impl<const K: usize> Bounds<K> {
     /// The same interval `[lo, hi]` for every variable.
     pub fn uniform(lo: f32, hi: f32) -> Self {
         Self {
-            lo: SVector::repeat(lo),
-            hi: SVector::repeat(hi),
+            lo: [lo; K],
+            hi: [hi; K],
         }
     }
 
     /// `z` clamped into the box.
-    pub fn project(&self, z: &SVector<f32, K>) -> SVector<f32, K> {
-        z.zip_zip_map(&self.lo, &self.hi, |v, lo, hi| v.max(lo).min(hi))
+    pub fn project(&self, z: &[f32; K]) -> [f32; K] {
+        self.project_v(&Vector::from(*z)).into()
+    }
+
+    pub(crate) fn project_v(&self, z: &Vector<K>) -> Vector<K> {
+        Vector::from_fn(|i, _| {
+            let v = z.get(i).copied().unwrap_or(0.0);
+            match (self.lo.get(i), self.hi.get(i)) {
+                (Some(&lo), Some(&hi)) => v.max(lo).min(hi),
+                _ => v,
+            }
+        })
     }
 
     /// Whether variable `i` can move in the direction `-g[i]`: neither
     /// pinned nor pushed against the bound it sits on.
-    pub fn free(&self, z: &SVector<f32, K>, g: &SVector<f32, K>, i: usize) -> bool {
+    pub(crate) fn free(&self, z: &Vector<K>, g: &Vector<K>, i: usize) -> bool {
         let (Some(&v), Some(&lo), Some(&hi), Some(&gi)) =
             (z.get(i), self.lo.get(i), self.hi.get(i), g.get(i))
         else {
@@ -76,8 +114,8 @@ impl<const K: usize> Bounds<K> {
 
     /// The gradient with the components of non-free variables zeroed:
     /// its norm is the projected-gradient stopping measure.
-    pub fn free_gradient(&self, z: &SVector<f32, K>, g: &SVector<f32, K>) -> SVector<f32, K> {
-        SVector::from_fn(|i, _| {
+    pub(crate) fn free_gradient(&self, z: &Vector<K>, g: &Vector<K>) -> Vector<K> {
+        Vector::from_fn(|i, _| {
             if self.free(z, g, i) {
                 g.get(i).copied().unwrap_or(0.0)
             } else {
@@ -86,15 +124,19 @@ impl<const K: usize> Bounds<K> {
         })
     }
 
-    /// The norm of [`Bounds::free_gradient`], computed without overflow
-    /// (scaled by its largest component): finite for any finite gradient.
-    pub fn free_gradient_norm(&self, z: &SVector<f32, K>, g: &SVector<f32, K>) -> f32 {
+    /// The norm of the free gradient, computed without overflow (scaled
+    /// by its largest component): finite for any finite gradient.
+    pub fn free_gradient_norm(&self, z: &[f32; K], g: &[f32; K]) -> f32 {
+        self.free_gradient_norm_v(&Vector::from(*z), &Vector::from(*g))
+    }
+
+    pub(crate) fn free_gradient_norm_v(&self, z: &Vector<K>, g: &Vector<K>) -> f32 {
         let f = self.free_gradient(z, g);
         let m = f.amax();
         if m > 0.0 && m.is_finite() {
-            m * (f / m).norm()
+            m * norm(&(f / m))
         } else {
-            f.norm()
+            norm(&f)
         }
     }
 
@@ -185,13 +227,14 @@ pub const HISTORY: usize = 256;
 
 /// Result of an optimization: where it stopped, why, and what it cost.
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Outcome<const K: usize> {
     /// The last accepted point.
-    pub z: SVector<f32, K>,
+    pub z: [f32; K],
     /// Objective there.
     pub j: f32,
     /// Gradient there.
-    pub gradient: SVector<f32, K>,
+    pub gradient: [f32; K],
     /// Norm of the gradient on the free variables.
     pub grad_norm: f32,
     /// Why it stopped.
@@ -209,11 +252,11 @@ pub struct Outcome<const K: usize> {
 
 impl<const K: usize> Outcome<K> {
     /// An outcome that has not run: at `z`, no history, `J = +inf`.
-    pub(crate) fn at(z: &SVector<f32, K>) -> Self {
+    pub(crate) fn at(z: &[f32; K]) -> Self {
         Self {
             z: *z,
             j: f32::INFINITY,
-            gradient: SVector::zeros(),
+            gradient: [0.0; K],
             grad_norm: 0.0,
             status: Status::Converged,
             iterations: 0,
@@ -224,12 +267,64 @@ impl<const K: usize> Outcome<K> {
     }
 }
 
+/// An optimizer setting out of range.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
+pub enum OptimConfigError {
+    /// `max_iterations` is 0.
+    MaxIterations,
+    /// `first_step` is not finite and positive (m).
+    FirstStep,
+    /// `max_step` is not finite and positive (m).
+    MaxStep,
+    /// A stopping tolerance is not finite and non-negative (the floor
+    /// positive).
+    Tolerances,
+    /// `armijo.c1` is not in (0, 1).
+    ArmijoC1,
+    /// `armijo.shrink` is not in (0, 1).
+    ArmijoShrink,
+    /// `armijo.max_backtracks` is 0.
+    ArmijoBacktracks,
+    /// The GD learning rate is not finite and positive (1/m).
+    GdRate,
+    /// A bound is not finite, or `lo > hi`.
+    Bounds,
+}
+
+impl OptimConfigError {
+    /// The setting's name, as the host tool's config file spells it.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::MaxIterations => "max_iterations",
+            Self::FirstStep => "first_step",
+            Self::MaxStep => "max_step",
+            Self::Tolerances => "tolerances",
+            Self::ArmijoC1 => "armijo.c1",
+            Self::ArmijoShrink => "armijo.shrink",
+            Self::ArmijoBacktracks => "armijo.max_backtracks",
+            Self::GdRate => "gd_rate",
+            Self::Bounds => "bounds",
+        }
+    }
+}
+
+impl fmt::Display for OptimConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "optimizer setting {} is out of range", self.name())
+    }
+}
+
+impl core::error::Error for OptimConfigError {}
+
 /// Why an optimizer could not start.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum OptimError<E> {
-    /// A configuration value is out of range (named).
-    Config(&'static str),
+    /// A configuration value is out of range.
+    Config(OptimConfigError),
     /// The objective could not be evaluated at the starting point.
     Start(E),
     /// The objective or gradient at the starting point is not finite.
@@ -239,7 +334,7 @@ pub enum OptimError<E> {
 impl<E: fmt::Display> fmt::Display for OptimError<E> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Config(p) => write!(f, "optimizer setting {p} is out of range"),
+            Self::Config(p) => p.fmt(f),
             Self::Start(e) => write!(f, "objective failed at the start: {e}"),
             Self::NonFinite => f.write_str("objective not finite at the start"),
         }
@@ -251,9 +346,9 @@ impl<E: fmt::Debug + fmt::Display> core::error::Error for OptimError<E> {}
 /// Evaluates at the start point, checking finiteness.
 fn start<const K: usize, O: Objective<K>>(
     obj: &mut O,
-    z: &SVector<f32, K>,
-) -> Result<(f32, SVector<f32, K>), OptimError<O::Error>> {
-    let (j, g) = obj.eval(z).map_err(OptimError::Start)?;
+    z: &Vector<K>,
+) -> Result<(f32, Vector<K>), OptimError<O::Error>> {
+    let (j, g) = eval(obj, z).map_err(OptimError::Start)?;
     if j.is_finite() && g.iter().all(|v| v.is_finite()) {
         Ok((j, g))
     } else {
@@ -273,14 +368,14 @@ pub(crate) mod testfns {
     }
     impl Objective<2> for Rosenbrock {
         type Error = ();
-        fn eval(&mut self, z: &SVector<f32, 2>) -> Result<(f32, SVector<f32, 2>), ()> {
+        fn eval(&mut self, z: &[f32; 2]) -> Result<(f32, [f32; 2]), ()> {
             self.evals += 1;
             let (x, y) = (z[0], z[1]);
             let j = (1.0 - x) * (1.0 - x) + 100.0 * (y - x * x) * (y - x * x);
-            let g = SVector::<f32, 2>::new(
+            let g = [
                 -2.0 * (1.0 - x) - 400.0 * x * (y - x * x),
                 200.0 * (y - x * x),
-            );
+            ];
             Ok((j, g))
         }
     }
@@ -292,9 +387,10 @@ pub(crate) mod testfns {
     }
     impl<const K: usize> Objective<K> for Quadratic<K> {
         type Error = ();
-        fn eval(&mut self, z: &SVector<f32, K>) -> Result<(f32, SVector<f32, K>), ()> {
+        fn eval(&mut self, z: &[f32; K]) -> Result<(f32, [f32; K]), ()> {
+            let z = SVector::from(*z);
             let hz = self.h * z;
-            Ok((0.5 * z.dot(&hz) - self.b.dot(z), hz - self.b))
+            Ok((0.5 * z.dot(&hz) - self.b.dot(&z), (hz - self.b).into()))
         }
     }
 }

@@ -35,9 +35,9 @@ pub struct TrackPlan {
     pub iterations: u32,
     /// Simulations run.
     pub evaluations: u32,
-    /// Entries of `Plan::history`.
+    /// Entries of `Planner::history`.
     pub history_len: u32,
-    /// FNV-1a over the bits of every `Plan::history` entry.
+    /// FNV-1a over the bits of every `Planner::history` entry.
     pub history_hash: u32,
     /// `x` and depth of `Plan::next_state`, m.
     pub next_x: f32,
@@ -58,7 +58,7 @@ pub fn fnv1a(values: &[f32]) -> u32 {
 
 impl TrackPlan {
     /// The comparable part of `p`.
-    pub fn of<const N: usize, const K: usize>(p: &Plan<N, K>) -> Self {
+    pub fn of<const N: usize, const K: usize>(p: &Plan<N>, planner: &Planner<K>) -> Self {
         Self {
             depth: p.depth,
             status: p.status.as_str(),
@@ -68,8 +68,8 @@ impl TrackPlan {
             objective: p.objective,
             iterations: p.iterations,
             evaluations: p.evaluations,
-            history_len: p.history.len() as u32,
-            history_hash: fnv1a(&p.history),
+            history_len: planner.history().len() as u32,
+            history_hash: fnv1a(planner.history()),
             next_x: p.next_state.x(),
             next_depth: p.next_state.depth(),
         }
@@ -93,7 +93,7 @@ pub fn trackwise_config() -> PlannerConfig {
 /// every track's full plan.
 pub fn plan_line<const K: usize>(
     cfg: PlannerConfig,
-    mut each: impl FnMut(usize, &Plan<3, K>),
+    mut each: impl FnMut(usize, &Plan<3>, &Planner<K>),
 ) -> Result<[TrackPlan; TRACKS], auvnav::Error> {
     let vehicle = Vehicle::c_auv4()?;
     let bottom = Profile::<S>::new(&monterey::X, &monterey::B)?;
@@ -104,8 +104,8 @@ pub fn plan_line<const K: usize>(
     let mut out = [TrackPlan::default(); TRACKS];
     for (track, slot) in out.iter_mut().enumerate() {
         let plan = planner.plan(&line, &state, track)?;
-        each(track, &plan);
-        *slot = TrackPlan::of(&plan);
+        each(track, &plan, &planner);
+        *slot = TrackPlan::of(&plan, &planner);
         state = plan.next_state;
     }
     Ok(out)
@@ -154,8 +154,8 @@ pub fn smoke() -> Result<Smoke, auvnav::Error> {
     let line = Scenario::new(&vehicle, &bottom, &waypoints, Mission::default())?;
     let mut out = Smoke::default();
     let p = vehicle.plant();
-    // Row-major, as `expected.rs` lists it (nalgebra stores columns).
-    for (slot, v) in out.ad.iter_mut().zip(p.ad().transpose().iter()) {
+    // Row-major, as `expected.rs` lists it.
+    for (slot, v) in out.ad.iter_mut().zip(p.ad().iter().flatten()) {
         *slot = *v;
     }
     for (slot, v) in out.bd.iter_mut().zip(p.bd().iter()) {
@@ -176,6 +176,7 @@ pub fn smoke() -> Result<Smoke, auvnav::Error> {
     let (first_scores, _) = scores.split_at_mut(last);
     let state = line.simulate(&start, 0, first_tracks, first_scores, |_| {})?;
     let mut planner = Planner::<1>::new(trackwise_config())?;
-    out.last_track = TrackPlan::of(&planner.plan(&line, &state, last)?);
+    let plan = planner.plan(&line, &state, last)?;
+    out.last_track = TrackPlan::of(&plan, &planner);
     Ok(out)
 }

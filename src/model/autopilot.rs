@@ -28,9 +28,9 @@
 //!   the loop and the anti-windup test with it. The depth loop's sign comes
 //!   from the kinematics (nose-down goes deeper) and never changes.
 
-use crate::error::{ConfigError, non_negative, positive};
+use super::check::{ConfigError, non_negative, positive};
+use super::plant::TransferFunction;
 use crate::num::clamp;
-use crate::plant::TransferFunction;
 
 /// Gains of one PID loop. Units depend on the loop (see
 /// [`AutopilotConfig`]).

@@ -32,11 +32,11 @@
 
 use nalgebra::{SMatrix, SVector};
 
+use crate::model::Vehicle;
 use crate::num::DEG;
-use crate::sim::{
-    EndAt, PieceLin, Scenario, Sensitivity, SimError, StepLin, TrackScore, VehicleState,
-};
-use crate::vehicle::Vehicle;
+
+use super::lin::{EndAt, PieceLin, Sensitivity, StepLin};
+use super::{Scenario, SimError, TrackScore, VehicleState};
 
 /// Tangents of the state with respect to `K` reference depths, and the
 /// accumulated gradients.
@@ -127,7 +127,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
         if lin.command.pitch_integrating {
             self.pitch_integral += e_t * ts;
         }
-        self.eta = plant.ad() * self.eta + plant.bd() * elevator.transpose();
+        self.eta = plant.ad_m() * self.eta + plant.bd_v() * elevator.transpose();
         let pitch_next = plant.pitch_of(&self.eta);
         let mean = (pitch + pitch_next) * (0.5 * DEG);
         let step = v.speed() * ts;
@@ -180,7 +180,7 @@ pub struct Evaluation<const N: usize, const K: usize> {
     pub end: VehicleState<N>,
 }
 
-impl<const N: usize, const S: usize, const W: usize> Scenario<'_, N, S, W> {
+impl<const N: usize> Scenario<'_, N> {
     /// Flies tracks `first_track..first_track + K` with reference depths
     /// `depths` (m) from `start`, and returns the scores with the exact
     /// gradient of `Σ J` and of the violation with respect to the depths.
@@ -215,7 +215,8 @@ impl<const N: usize, const S: usize, const W: usize> Scenario<'_, N, S, W> {
         let used = depths.get(..count).ok_or(SimError::TrackRange)?;
         let mut scores = [TrackScore::default(); K];
         let mut tan = Tangents::<N, K>::zero();
-        let end = self.run(start, first_track, used, &mut scores, &mut tan, |_| {})?;
+        let end =
+            self.run::<_, _, true>(start, first_track, used, &mut scores, &mut tan, |_| {})?;
         let grad_j: [f32; K] = tan.grad_j.into();
         let grad_violation: [f32; K] = tan.grad_violation.into();
         if !grad_j.iter().chain(&grad_violation).all(|g| g.is_finite()) {

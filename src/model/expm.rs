@@ -22,7 +22,8 @@ const MAX_SQUARINGS: u8 = 40;
 ///
 /// Returns `None` when `m` is not finite or its norm is beyond
 /// `0.5 · 2^40`, where f32 cannot represent the result meaningfully.
-pub fn expm<const N: usize>(m: &SMatrix<f32, N, N>) -> Option<SMatrix<f32, N, N>> {
+#[cfg(test)]
+pub(crate) fn expm<const N: usize>(m: &SMatrix<f32, N, N>) -> Option<SMatrix<f32, N, N>> {
     let (e, _) = expm1_phi1(m, 1.0)?;
     Some(SMatrix::identity() + e)
 }
@@ -31,7 +32,7 @@ pub fn expm<const N: usize>(m: &SMatrix<f32, N, N>) -> Option<SMatrix<f32, N, N>
 /// returns `(Ad, Bd) = (exp(A ts), ∫_0^ts exp(A τ) dτ · B)`.
 ///
 /// Returns `None` when the inputs are not finite or `||A ts||` is too large.
-pub fn zoh<const N: usize>(
+pub(crate) fn zoh<const N: usize>(
     a: &SMatrix<f32, N, N>,
     b: &SMatrix<f32, N, 1>,
     ts: f32,

@@ -24,13 +24,13 @@
 //! the tests compare it with the f64 reference's (scipy's `tf2ss`) form.
 //! When `n < N` the last `N - n` states are padding: zero rows and columns,
 //! they stay exactly zero. Discretization is the exact zero-order hold,
-//! computed in f32 by [`crate::expm::zoh`].
+//! computed in f32 by [`super::expm::zoh`].
 
 use core::fmt;
 
 use nalgebra::{SMatrix, SVector};
 
-use crate::expm;
+use super::expm;
 
 /// Why a transfer function or its discretization was rejected.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -263,9 +263,15 @@ impl<const N: usize> TransferFunction<N> {
     }
 
     /// The continuous state-space matrices `(A, B, C)` of the observability
-    /// canonical form (module docs): `A` in 1/s, `B` in state per deg of
-    /// elevator per second, `C` the pitch row (a column vector `e1`).
-    pub fn realization(&self) -> (SMatrix<f32, N, N>, SVector<f32, N>, SVector<f32, N>) {
+    /// canonical form (module docs): `A` (row-major) in 1/s, `B` in state
+    /// per deg of elevator per second, `C` the pitch row `e1`.
+    pub fn realization(&self) -> ([[f32; N]; N], [f32; N], [f32; N]) {
+        let (a, b, c) = self.realization_m();
+        (rows(&a), b.into(), c.into())
+    }
+
+    /// [`TransferFunction::realization`] in nalgebra's types.
+    pub(crate) fn realization_m(&self) -> (SMatrix<f32, N, N>, SVector<f32, N>, SVector<f32, N>) {
         let n = self.order;
         let mut a = SMatrix::<f32, N, N>::zeros();
         for i in 1..n {
@@ -346,7 +352,7 @@ impl<const N: usize> Plant<N> {
         if !(sample_time.is_finite() && sample_time > 0.0) {
             return Err(PlantError::SampleTime);
         }
-        let (a, b, c) = tf.realization();
+        let (a, b, c) = tf.realization_m();
         let (ad, bd) = expm::zoh(&a, &b, sample_time).ok_or(PlantError::Discretization)?;
         let ca = a.transpose() * c;
         Ok(Self {
@@ -370,40 +376,68 @@ impl<const N: usize> Plant<N> {
         self.sample_time
     }
 
-    /// Continuous state matrix `A`, 1/s.
-    pub fn a(&self) -> &SMatrix<f32, N, N> {
-        &self.a
+    /// Continuous state matrix `A`, 1/s, row-major.
+    pub fn a(&self) -> [[f32; N]; N] {
+        rows(&self.a)
     }
 
-    /// `Ad = exp(A Ts)`.
-    pub fn ad(&self) -> &SMatrix<f32, N, N> {
-        &self.ad
+    /// `Ad = exp(A Ts)`, row-major.
+    pub fn ad(&self) -> [[f32; N]; N] {
+        rows(&self.ad)
     }
 
     /// `Bd = ∫_0^Ts exp(A τ) dτ B`, state per deg of elevator.
-    pub fn bd(&self) -> &SVector<f32, N> {
+    pub fn bd(&self) -> [f32; N] {
+        self.bd.into()
+    }
+
+    /// Output row `C` (pitch, deg, per state): `e1`.
+    pub fn c(&self) -> [f32; N] {
+        self.c.into()
+    }
+
+    /// `C A`: pitch rate, deg/s, per state: `e2`.
+    pub fn ca(&self) -> [f32; N] {
+        self.ca.into()
+    }
+
+    /// Pitch `θ = C η = η1`, deg, of a plant state `η`.
+    pub fn pitch(&self, eta: &[f32; N]) -> f32 {
+        eta.first().copied().unwrap_or(0.0)
+    }
+
+    /// Pitch rate `q = C A η = η2`, deg/s, of a plant state `η`.
+    pub fn pitch_rate(&self, eta: &[f32; N]) -> f32 {
+        eta.get(1).copied().unwrap_or(0.0)
+    }
+
+    /// One sample from plant state `η`: `Ad η + Bd δ` with the elevator
+    /// `δ` (deg) held.
+    pub fn step(&self, eta: &[f32; N], elevator: f32) -> [f32; N] {
+        self.step_v(&SVector::from(*eta), elevator).into()
+    }
+
+    /// `Ad` as the simulation multiplies it.
+    #[inline(always)]
+    pub(crate) fn ad_m(&self) -> &SMatrix<f32, N, N> {
+        &self.ad
+    }
+
+    /// `Bd` as the simulation multiplies it.
+    #[inline(always)]
+    pub(crate) fn bd_v(&self) -> &SVector<f32, N> {
         &self.bd
     }
 
-    /// Output row `C` (pitch, deg, per state), as a column vector: `e1`.
-    pub fn c(&self) -> &SVector<f32, N> {
-        &self.c
-    }
-
-    /// `(C A)ᵀ`: pitch rate, deg/s, per state: `e2`.
-    pub fn ca(&self) -> &SVector<f32, N> {
-        &self.ca
-    }
-
-    /// Pitch `θ = C η = η1`, deg.
+    /// [`Plant::pitch`] on the simulation's vector type.
     #[inline(always)]
-    pub fn pitch(&self, eta: &SVector<f32, N>) -> f32 {
+    pub(crate) fn pitch_v(&self, eta: &SVector<f32, N>) -> f32 {
         eta.get(0).copied().unwrap_or(0.0)
     }
 
-    /// Pitch rate `q = C A η = η2`, deg/s.
+    /// [`Plant::pitch_rate`] on the simulation's vector type.
     #[inline(always)]
-    pub fn pitch_rate(&self, eta: &SVector<f32, N>) -> f32 {
+    pub(crate) fn pitch_rate_v(&self, eta: &SVector<f32, N>) -> f32 {
         eta.get(1).copied().unwrap_or(0.0)
     }
 
@@ -419,11 +453,16 @@ impl<const N: usize> Plant<N> {
         SVector::from_fn(|k, _| m.get((1, k)).copied().unwrap_or(0.0))
     }
 
-    /// One sample: `Ad η + Bd δ` with the elevator `δ` (deg) held.
+    /// [`Plant::step`] on the simulation's vector type.
     #[inline(always)]
-    pub fn step(&self, eta: &SVector<f32, N>, elevator: f32) -> SVector<f32, N> {
+    pub(crate) fn step_v(&self, eta: &SVector<f32, N>, elevator: f32) -> SVector<f32, N> {
         self.ad * eta + self.bd * elevator
     }
+}
+
+/// A matrix as row-major arrays.
+fn rows<const N: usize>(m: &SMatrix<f32, N, N>) -> [[f32; N]; N] {
+    core::array::from_fn(|i| core::array::from_fn(|j| m.get((i, j)).copied().unwrap_or(0.0)))
 }
 
 #[cfg(test)]
@@ -461,7 +500,7 @@ mod tests {
         );
         // deg N = 1 = n - 2 is allowed: C B = 0 still.
         let tf = TransferFunction::<3>::pitch(&[1.0, -0.173], &den).unwrap();
-        let (_, b, c) = tf.realization();
+        let (_, b, c) = tf.realization_m();
         assert_eq!(c.dot(&b), 0.0);
         assert_eq!(
             TransferFunction::<2>::pitch(&[-0.173], &den),
@@ -497,10 +536,10 @@ mod tests {
         assert_eq!(tf.order(), 2);
         let p = Plant::new(tf, 0.1).unwrap();
         // Padding states neither move nor are driven.
-        assert_eq!(p.ad()[(2, 2)], 1.0);
-        assert_eq!(p.ad()[(3, 3)], 1.0);
+        assert_eq!(p.ad()[2][2], 1.0);
+        assert_eq!(p.ad()[3][3], 1.0);
         assert_eq!(p.bd()[2], 0.0);
-        assert_eq!(p.ad()[(0, 2)], 0.0);
+        assert_eq!(p.ad()[0][2], 0.0);
     }
 
     #[test]
@@ -510,7 +549,7 @@ mod tests {
         let num = [0.3_f32, -0.5];
         let den = [1.0_f32, 2.0, 1.5, 0.4];
         let tf = TransferFunction::<4>::pitch(&num, &den).unwrap();
-        let (a, b, c) = tf.realization();
+        let (a, b, c) = tf.realization_m();
         for s in [0.25_f32, 1.0, 3.0] {
             let m = SMatrix::<f32, 4, 4>::identity() * s - a;
             let x = m.try_inverse().unwrap() * b;
@@ -532,7 +571,7 @@ mod tests {
     #[test]
     fn steady_state_pitch_is_dc_gain() {
         let p = Plant::new(TransferFunction::C_AUV4, 0.1).unwrap();
-        let mut eta = SVector::<f32, 3>::zeros();
+        let mut eta = [0.0_f32; 3];
         for _ in 0..5000 {
             eta = p.step(&eta, 1.0);
         }

@@ -1,10 +1,9 @@
 //! The vehicle as the planner sees it: speed, sample time, plant and
-//! autopilot, validated together; and the mission's altitudes and depth
-//! limits.
+//! autopilot, validated together.
 
-use crate::autopilot::{Autopilot, AutopilotConfig};
-use crate::error::{ConfigError, finite, positive};
-use crate::plant::{Plant, TransferFunction};
+use super::autopilot::{Autopilot, AutopilotConfig};
+use super::check::{ConfigError, positive};
+use super::plant::{Plant, TransferFunction};
 
 /// Power-iteration steps of the stability check, and the window over which
 /// the growth is measured.
@@ -107,8 +106,8 @@ impl<const N: usize> Vehicle<N> {
         let (mut d, mut dp, mut id, mut it) = (1.0_f32, 0.5_f32, 0.1_f32, 0.1_f32);
         let mut window = 0.0_f32;
         for k in 0..GROWTH_STEPS {
-            let theta = self.plant.pitch(&eta);
-            let q = self.plant.pitch_rate(&eta);
+            let theta = self.plant.pitch_v(&eta);
+            let q = self.plant.pitch_rate_v(&eta);
             let e_d = -d;
             let v = -(gd.kp * e_d + gd.ki * id - gd.kd * (d - dp) / ts);
             let e_t = v - theta;
@@ -121,8 +120,8 @@ impl<const N: usize> Vehicle<N> {
             if gp.ki != 0.0 {
                 it += ts * e_t;
             }
-            eta = self.plant.step(&eta, w);
-            let theta_next = self.plant.pitch(&eta);
+            eta = self.plant.step_v(&eta, w);
+            let theta_next = self.plant.pitch_v(&eta);
             dp = d;
             d -= step * 0.5 * (theta + theta_next);
             // Renormalize; accumulate the log growth over the last window.
@@ -164,96 +163,9 @@ impl<const N: usize> Vehicle<N> {
     }
 }
 
-/// The mission's altitude envelope and allowed reference depths.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub struct Mission {
-    reference_altitude: f32,
-    min_altitude: f32,
-    depth_limits: [f32; 2],
-}
-
-impl Default for Mission {
-    /// The paper's `h_r = 80 m`, `h_a = 60 m`, depths `[0, 6000]` m.
-    fn default() -> Self {
-        Self {
-            reference_altitude: 80.0,
-            min_altitude: 60.0,
-            depth_limits: [0.0, 6000.0],
-        }
-    }
-}
-
-impl Mission {
-    /// `h_r` reference altitude (m), `h_a` minimum altitude (m) with
-    /// `0 < h_a <= h_r`, and the allowed reference depths `[min, max]` (m).
-    ///
-    /// # Errors
-    /// [`ConfigError`] for non-finite values, `h_a <= 0`, `h_a > h_r`, or
-    /// reversed depth limits.
-    pub fn new(
-        reference_altitude: f32,
-        min_altitude: f32,
-        depth_limits: [f32; 2],
-    ) -> Result<Self, ConfigError> {
-        finite(reference_altitude, "reference_altitude")?;
-        positive(min_altitude, "min_altitude")?;
-        if min_altitude > reference_altitude {
-            return Err(ConfigError::MinAltitudeAboveReference);
-        }
-        let [lo, hi] = depth_limits;
-        finite(lo, "depth_limits")?;
-        finite(hi, "depth_limits")?;
-        if lo > hi {
-            return Err(ConfigError::DepthLimitsReversed);
-        }
-        Ok(Self {
-            reference_altitude,
-            min_altitude,
-            depth_limits,
-        })
-    }
-
-    /// `h_r`, m: the target depth is the bottom shifted up by `h_r`.
-    pub fn reference_altitude(&self) -> f32 {
-        self.reference_altitude
-    }
-
-    /// `h_a`, m: the flight must stay at least this high above the bottom.
-    pub fn min_altitude(&self) -> f32 {
-        self.min_altitude
-    }
-
-    /// Allowed reference depths `[min, max]`, m.
-    pub fn depth_limits(&self) -> [f32; 2] {
-        self.depth_limits
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn mission_validation() {
-        assert!(Mission::new(80.0, 60.0, [0.0, 6000.0]).is_ok());
-        assert_eq!(
-            Mission::new(50.0, 60.0, [0.0, 6000.0]),
-            Err(ConfigError::MinAltitudeAboveReference)
-        );
-        assert_eq!(
-            Mission::new(80.0, 0.0, [0.0, 6000.0]),
-            Err(ConfigError::NotPositive("min_altitude"))
-        );
-        assert_eq!(
-            Mission::new(80.0, 60.0, [10.0, 0.0]),
-            Err(ConfigError::DepthLimitsReversed)
-        );
-        assert_eq!(
-            Mission::new(f32::NAN, 60.0, [0.0, 1.0]),
-            Err(ConfigError::NonFinite("reference_altitude"))
-        );
-    }
 
     #[test]
     fn vehicle_validation() {
@@ -313,7 +225,7 @@ mod tests {
         assert!(unstable(|_| {}).is_ok());
         assert!(unstable(|c| c.autopilot.depth_pid.ki = 0.02).is_ok());
         assert!(
-            unstable(|c| c.autopilot.depth_pid = crate::PidGains {
+            unstable(|c| c.autopilot.depth_pid = crate::model::PidGains {
                 kp: 0.0,
                 ki: 0.0,
                 kd: 0.0

@@ -14,6 +14,7 @@ use crate::num::Comp;
 /// Why a bottom profile was rejected or a query failed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[non_exhaustive]
 pub enum ProfileError {
     /// Fewer than two samples: nothing to interpolate.
     TooFewSamples {
@@ -76,6 +77,31 @@ impl fmt::Display for ProfileError {
 
 impl core::error::Error for ProfileError {}
 
+/// The rules of model contract §2: equal lengths, at least two samples,
+/// all finite, `x` strictly increasing.
+fn validate(x: &[f32], depth: &[f32]) -> Result<(), ProfileError> {
+    if x.len() != depth.len() {
+        return Err(ProfileError::LengthMismatch {
+            x_len: x.len(),
+            depth_len: depth.len(),
+        });
+    }
+    if x.len() < 2 {
+        return Err(ProfileError::TooFewSamples { len: x.len() });
+    }
+    let mut last = f32::NEG_INFINITY;
+    for (index, (&xi, &bi)) in x.iter().zip(depth).enumerate() {
+        if !xi.is_finite() || !bi.is_finite() {
+            return Err(ProfileError::NonFinite { index });
+        }
+        if xi <= last {
+            return Err(ProfileError::NotIncreasing { index });
+        }
+        last = xi;
+    }
+    Ok(())
+}
+
 /// Along-track bottom profile with room for `S` samples.
 ///
 /// Positions `x` in metres from the first waypoint (strictly increasing),
@@ -97,45 +123,26 @@ impl<const S: usize> Profile<S> {
     /// strictly increase.
     pub fn new(x: &[f32], depth: &[f32]) -> Result<Self, ProfileError> {
         const { assert!(S >= 2, "a profile needs capacity for at least 2 samples") };
-        if x.len() != depth.len() {
-            return Err(ProfileError::LengthMismatch {
-                x_len: x.len(),
-                depth_len: depth.len(),
-            });
-        }
-        if x.len() < 2 {
-            return Err(ProfileError::TooFewSamples { len: x.len() });
-        }
-        if x.len() > S {
-            return Err(ProfileError::OverCapacity {
-                len: x.len(),
-                capacity: S,
-            });
-        }
-        let mut out = Self {
-            x: Vec::new(),
-            depth: Vec::new(),
+        let over = ProfileError::OverCapacity {
+            len: x.len(),
+            capacity: S,
         };
-        let mut last = f32::NEG_INFINITY;
-        for (index, (&xi, &bi)) in x.iter().zip(depth).enumerate() {
-            if !xi.is_finite() || !bi.is_finite() {
-                return Err(ProfileError::NonFinite { index });
-            }
-            if xi <= last {
-                return Err(ProfileError::NotIncreasing { index });
-            }
-            last = xi;
-            // Capacity was checked above; a failed push cannot happen, but
-            // is still reported rather than ignored.
-            out.x
-                .push(xi)
-                .and_then(|()| out.depth.push(bi))
-                .map_err(|_| ProfileError::OverCapacity {
-                    len: x.len(),
-                    capacity: S,
-                })?;
+        if x.len() == depth.len() && x.len() > S {
+            return Err(over);
         }
-        Ok(out)
+        validate(x, depth)?;
+        Ok(Self {
+            x: Vec::from_slice(x).map_err(|_| over)?,
+            depth: Vec::from_slice(depth).map_err(|_| over)?,
+        })
+    }
+
+    /// The capacity-erased view a [`crate::sim::Scenario`] holds.
+    pub fn view(&self) -> ProfileView<'_> {
+        ProfileView {
+            x: &self.x,
+            depth: &self.depth,
+        }
     }
 
     /// Number of samples (at least 2).
@@ -156,6 +163,66 @@ impl<const S: usize> Profile<S> {
     /// Sample bottom depths, m, positive down.
     pub fn depths(&self) -> &[f32] {
         &self.depth
+    }
+
+    /// First sample position, m.
+    pub fn start(&self) -> f32 {
+        self.view().start()
+    }
+
+    /// Last sample position, m.
+    pub fn end(&self) -> f32 {
+        self.view().end()
+    }
+
+    /// Bottom depth `b(x)` at position `x` (m), linearly interpolated, m.
+    ///
+    /// # Errors
+    /// [`ProfileError::OutOfRange`] when `x` is outside the samples or NaN.
+    pub fn depth_at(&self, x: f32) -> Result<f32, ProfileError> {
+        self.view().depth_at(x)
+    }
+}
+
+/// A borrowed, capacity-erased view of a validated profile: what a
+/// [`crate::sim::Scenario`] holds, whatever the capacity `S` of the
+/// [`Profile`] it came from (as heapless' `VecView`).
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ProfileView<'a> {
+    x: &'a [f32],
+    depth: &'a [f32],
+}
+
+impl<'a> ProfileView<'a> {
+    /// Validates borrowed samples (e.g. `static` arrays in firmware) with
+    /// the rules of [`Profile::new`], without copying them.
+    ///
+    /// # Errors
+    /// [`ProfileError`] as [`Profile::new`], except `OverCapacity`.
+    pub fn new(x: &'a [f32], depth: &'a [f32]) -> Result<Self, ProfileError> {
+        validate(x, depth)?;
+        Ok(Self { x, depth })
+    }
+
+    /// Number of samples (at least 2).
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Always `false`: a valid profile has at least two samples.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Sample positions, m.
+    pub fn positions(&self) -> &'a [f32] {
+        self.x
+    }
+
+    /// Sample bottom depths, m, positive down.
+    pub fn depths(&self) -> &'a [f32] {
+        self.depth
     }
 
     /// First sample position, m.
@@ -372,7 +439,7 @@ mod tests {
         let p = ramp();
         let mut c = Cursor::default();
         for &(x, want) in &[(1.0, 99.0), (35.0, 120.0), (12.0, 90.0), (2.0, 98.0)] {
-            let got = p.locate(&mut c, Comp::new(x)).unwrap().depth;
+            let got = p.view().locate(&mut c, Comp::new(x)).unwrap().depth;
             assert!((got - want).abs() < 1e-5, "{x}: {got} vs {want}");
         }
     }

@@ -1,0 +1,214 @@
+//! The safe-set boundary of one variable: a bracketed root search on a
+//! margin `g(z)` (for the planner, minimum altitude − certified altitude),
+//! approached from the safe side (`g >= 0`).
+//!
+//! `g` is typically a hinge: flat where the track's lowest point is passed
+//! before the vehicle reaches its reference, falling about a metre per
+//! metre of reference depth beyond. So the first step (and any step after
+//! an unsafe evaluation that gave no usable secant) moves from the unsafe
+//! end by its deficit, which lands on the boundary on the sloped side;
+//! then the secant through the two latest evaluations, and the Illinois
+//! variant of regula falsi on the bracket when the secant falls outside it
+//! (Dowell & Jarratt 1971). Each aims at half the tolerance above 0.
+
+/// One end of a bracket: a point and its margin when known.
+pub(crate) type End = (f32, Option<f32>);
+
+/// What the search found.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Root<T> {
+    /// The safe end, and what its evaluation returned when it was
+    /// evaluated here (`None`: the caller's own `good` end, unmoved and
+    /// given with its margin).
+    pub z: f32,
+    pub at: Option<T>,
+    /// The safe end before it, with its payload, if the end moved.
+    pub inner: Option<(f32, T)>,
+}
+
+/// Stopping rules: the safe end within `tol` of 0 (same unit as `g`), the
+/// bracket under `width` (unit of `z`), or `steps` evaluations.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RootTol {
+    pub tol: f32,
+    pub width: f32,
+    pub steps: u32,
+}
+
+/// The state of the search between two evaluations.
+struct Search {
+    good: f32,
+    g_good: f32,
+    bad: f32,
+    g_bad: f32,
+    /// The two latest evaluations `(z, g)`, newest first.
+    latest: Option<((f32, f32), (f32, f32))>,
+    /// Which end the last step kept (Illinois halves its value).
+    kept_good: bool,
+    kept_bad: bool,
+}
+
+impl Search {
+    /// Where to evaluate next, as a fraction of the way from `good` to
+    /// `bad`.
+    fn next_t(&self, step: u32, tol: f32) -> f32 {
+        let (good, bad, g_good, g_bad) = (self.good, self.bad, self.g_good, self.g_bad);
+        // Regula falsi, kept inside the middle 98 % of the bracket.
+        let t = if g_good > 0.0 && g_bad < 0.0 && (g_good - g_bad).is_finite() {
+            (g_good / (g_good - g_bad)).clamp(0.01, 0.99)
+        } else {
+            0.5
+        };
+        let width = libm::fabsf(good - bad);
+        // The unit step from the unsafe end: its deficit plus half the
+        // tolerance (the hinge's sloped side falls at unit slope).
+        let unit = -g_bad + 0.5 * tol;
+        let aim = |z: f32| (z - good) / (bad - good);
+        // The secant, when it has two distinct margins and lands inside.
+        let secant = self.latest.and_then(|((z1, g1), (z2, g2))| {
+            let ts = aim(z1 + (0.5 * tol - g1) * (z1 - z2) / (g1 - g2));
+            (libm::fabsf(g1 - g2) > 0.0 && ts > 0.01 && ts < 0.99).then_some(ts)
+        });
+        // First, and whenever the newest evaluation was unsafe and gave no
+        // usable secant (both on a flat stretch): the unit step.
+        let newest_bad = self.latest.is_none_or(|((_, g1), _)| g1 < 0.0);
+        match secant {
+            _ if step == 0 && g_bad < 0.0 && unit < width => 1.0 - unit / width,
+            Some(ts) => ts,
+            None if newest_bad && g_bad < 0.0 && unit < width => 1.0 - unit / width,
+            None => t,
+        }
+    }
+}
+
+/// Searches the boundary between a safe `good` end and an unsafe `bad`
+/// one. `eval(z)` returns `g(z)` with a payload, or `Err` where it cannot
+/// be evaluated (treated as unsafe, except at an unknown `good` end,
+/// whose failure is returned).
+///
+/// # Errors
+/// The error of evaluating `good`, when its margin was not given.
+pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
+    good: End,
+    bad: End,
+    rule: RootTol,
+    mut eval: F,
+) -> Result<Root<T>, E> {
+    let mut at = None;
+    let g_good = match good.1 {
+        Some(g) => g,
+        None => {
+            let (g, p) = eval(good.0)?;
+            at = Some(p);
+            g
+        }
+    };
+    let g_bad = match bad.1 {
+        Some(g) => g,
+        None => eval(bad.0).map_or(-1.0, |(g, _)| g),
+    };
+    let mut s = Search {
+        good: good.0,
+        g_good,
+        bad: bad.0,
+        g_bad,
+        latest: None,
+        kept_good: false,
+        kept_bad: false,
+    };
+    let mut inner = None;
+    for step in 0..rule.steps {
+        if s.g_good <= rule.tol || libm::fabsf(s.good - s.bad) <= rule.width {
+            break;
+        }
+        let mid = s.good + s.next_t(step, rule.tol) * (s.bad - s.good);
+        let flown = eval(mid);
+        let g_mid = flown.as_ref().map_or(f32::NEG_INFINITY, |(g, _)| *g);
+        s.latest = g_mid
+            .is_finite()
+            .then(|| ((mid, g_mid), s.latest.map_or((s.bad, s.g_bad), |l| l.0)));
+        match flown {
+            Ok((g, p)) if g >= 0.0 => {
+                if let Some(prev) = at {
+                    inner = Some((s.good, prev));
+                }
+                s.good = mid;
+                s.g_good = g;
+                at = Some(p);
+                if s.kept_bad {
+                    s.g_bad *= 0.5;
+                }
+                s.kept_bad = true;
+                s.kept_good = false;
+            }
+            r => {
+                s.bad = mid;
+                s.g_bad = r.map_or(-1.0, |(g, _)| g);
+                if s.kept_good {
+                    s.g_good *= 0.5;
+                }
+                s.kept_good = true;
+                s.kept_bad = false;
+            }
+        }
+    }
+    Ok(Root {
+        z: s.good,
+        at,
+        inner,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rule() -> RootTol {
+        RootTol {
+            tol: 0.02,
+            width: 1e-3,
+            steps: 16,
+        }
+    }
+
+    /// A hinge: flat (margin 5) above 100 m, falling 1 m per m below.
+    fn hinge(z: f32) -> Result<(f32, f32), ()> {
+        Ok((5.0_f32.min(105.0 - z), z))
+    }
+
+    #[test]
+    fn lands_on_the_sloped_side_of_a_hinge_in_one_step() {
+        let mut n = 0;
+        let r = safe_boundary((80.0, None), (150.0, None), rule(), |z| {
+            n += 1;
+            hinge(z)
+        })
+        .unwrap();
+        let g = hinge(r.z).unwrap().0;
+        assert!((0.0..=0.02).contains(&g), "{} -> {g}", r.z);
+        // Both ends, then the unit step.
+        assert_eq!(n, 3);
+    }
+
+    #[test]
+    fn stays_safe_on_a_smooth_margin() {
+        let f = |z: f32| -> Result<(f32, ()), ()> { Ok((10.0 - 0.01 * z * z, ())) };
+        let r = safe_boundary((0.0, None), (50.0, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        assert!((0.0..=0.02).contains(&g), "{} -> {g}", r.z);
+    }
+
+    #[test]
+    fn failed_evaluations_count_as_unsafe() {
+        let f = |z: f32| {
+            if z > 10.0 {
+                Err(())
+            } else {
+                Ok((10.0 - z, ()))
+            }
+        };
+        let r = safe_boundary((0.0, None), (20.0, None), rule(), f).unwrap();
+        assert!(r.z <= 10.0 && r.z > 9.9, "{}", r.z);
+        assert!(safe_boundary((11.0, None), (20.0, None), rule(), f).is_err());
+    }
+}

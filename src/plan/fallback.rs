@@ -1,0 +1,127 @@
+//! When the optimum is not safe: the safe depth closest to it (among the
+//! scanned depths, then on the safe-set boundary by a root search), or,
+//! when no depth in the box is safe, the safest one found.
+
+use crate::optim::root::{self, RootTol};
+use crate::sim::{TrackScore, VehicleState};
+
+use super::PlanError;
+use super::planner::Flights;
+use super::scan::{ScanLog, grid};
+
+/// The boundary search stops when the safe end is within this much of the
+/// certified altitude `h_a + m_s` at most, m (where `h_r − h_a` is 10 m or
+/// more).
+const BOUNDARY_ALTITUDE: f32 = 0.02;
+
+/// ... or within this share of `h_r − h_a`, if less.
+const BOUNDARY_SHARE: f32 = 0.002;
+
+/// ... or when the bracket is this narrow, m (see `BOUNDARY_ALTITUDE`).
+const BOUNDARY_DEPTH: f32 = 1e-3;
+
+/// A depth with its flight.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Flown<const N: usize> {
+    pub depth: f32,
+    pub score: TrackScore,
+    pub next: VehicleState<N>,
+}
+
+/// What [`boundary`] found.
+pub(super) struct Boundary<const N: usize> {
+    /// The safe end, m, with its flight.
+    pub at: Flown<N>,
+    /// The safe end before it, with its `J` (m, m³), if it moved.
+    pub inner: Option<(f32, f32)>,
+}
+
+/// The safe-set boundary between a safe depth `good` and an unsafe one
+/// `bad` (each with its minimum altitude when known), from the safe side:
+/// [`crate::optim::root`] on `g(z) = min altitude − h_safe`. The altitude
+/// tolerance: `J` changes by about `2 δz / (h_r − h_a)` relatively when the
+/// boundary moves by `δz`, so 0.2 % of the envelope keeps that under
+/// 0.4 %; at most `BOUNDARY_ALTITUDE`, at least a millimetre.
+pub(super) fn boundary<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    good: (f32, Option<f32>),
+    bad: (f32, Option<f32>),
+    h_safe: f32,
+    steps: u32,
+) -> Result<Boundary<N>, PlanError> {
+    let m = fl.sc.mission();
+    let rule = RootTol {
+        tol: (BOUNDARY_SHARE * (m.reference_altitude() - m.min_altitude()))
+            .clamp(BOUNDARY_DEPTH, BOUNDARY_ALTITUDE),
+        width: BOUNDARY_DEPTH,
+        steps,
+    };
+    let margin = |a: Option<f32>| a.map(|a| a - h_safe);
+    let r = root::safe_boundary(
+        (good.0, margin(good.1)),
+        (bad.0, margin(bad.1)),
+        rule,
+        |z| fl.fly(z).map(|(s, n)| (s.min_altitude() - h_safe, (s, n))),
+    )?;
+    let (score, next) = match r.at {
+        Some(f) => f,
+        None => fl.fly(r.z)?,
+    };
+    Ok(Boundary {
+        at: Flown {
+            depth: r.z,
+            score,
+            next,
+        },
+        inner: r.inner.map(|(z, (s, _))| (z, s.j())),
+    })
+}
+
+/// The safe depth closest to `z_opt` in `[lo, hi]` (flagged safe), or the
+/// safest depth when none is safe.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fallback<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    (z_opt, alt_opt): (f32, Option<f32>),
+    (lo, hi): (f32, f32),
+    h_safe: f32,
+    scan_points: u32,
+    steps: u32,
+    log: &mut ScanLog,
+) -> Result<(Flown<N>, bool), PlanError> {
+    if log.is_empty() {
+        for k in 0..scan_points {
+            let z = grid(lo, hi, k, scan_points);
+            if let Ok((s, _)) = fl.fly(z) {
+                log.push(z, &s);
+            }
+        }
+    }
+    match log.nearest_safe(z_opt, h_safe) {
+        Some((z_safe, _, alt_safe)) => {
+            let b = boundary(
+                fl,
+                (z_safe, Some(alt_safe)),
+                (z_opt, alt_opt),
+                h_safe,
+                steps,
+            )?;
+            let safe = b.at.score.min_altitude() >= h_safe;
+            Ok((b.at, safe))
+        }
+        None => {
+            let z = log
+                .safest()
+                .ok_or(PlanError::Sim(crate::sim::SimError::Diverged))?;
+            let (score, next) = fl.fly(z)?;
+            Ok((
+                Flown {
+                    depth: z,
+                    score,
+                    next,
+                },
+                false,
+            ))
+        }
+    }
+}

@@ -1,0 +1,261 @@
+//! The starting point: the box of depths worth searching, and a coarse
+//! scan of it track by track (model contract §10: never start on a
+//! plateau that is not the best scanned value).
+
+use crate::num::DEG;
+use crate::optim::Bounds;
+use crate::sim::{Scenario, TrackScore, VehicleState};
+
+use super::planner::Flights;
+use super::{MAX_SCAN, PlanError};
+
+/// Point `k` of `n >= 2` evenly spaced over `[lo, hi]`.
+pub(super) fn grid(lo: f32, hi: f32, k: u32, n: u32) -> f32 {
+    let z = lo + (hi - lo) * (k as f32) / (n.saturating_sub(1).max(1) as f32);
+    // Rounding must not put a point outside the box (hence, possibly,
+    // outside the depth limits).
+    if z > hi {
+        hi
+    } else if z < lo {
+        lo
+    } else {
+        z
+    }
+}
+
+/// The box of depths worth searching for each track of the horizon (see
+/// the module docs of [`crate::plan`]); variables past `h` are pinned.
+pub(super) fn search_box<const N: usize, const K: usize>(
+    sc: &Scenario<'_, N>,
+    state: &VehicleState<N>,
+    track: usize,
+    h: usize,
+) -> Bounds<K> {
+    let ap = sc.vehicle().autopilot().config();
+    let angle = ((1.3 * ap.pitch_limit).min(90.0) * DEG).min(core::f32::consts::FRAC_PI_2);
+    let (sin, _) = crate::num::sin_cos(angle);
+    let saturation = if ap.depth_pid.kp > 0.0 {
+        3.0 * ap.pitch_limit / ap.depth_pid.kp
+    } else {
+        f32::INFINITY
+    };
+    let [dmin, dmax] = sc.mission().depth_limits();
+    let wp = sc.waypoints().positions();
+    let d = state.depth();
+    let mut reach = saturation + 20.0;
+    let mut b = Bounds::<K>::uniform(dmin, dmin);
+    for j in 0..h.min(K) {
+        let t = track.saturating_add(j);
+        let len = match (wp.get(t), wp.get(t.saturating_add(1))) {
+            (Some(a), Some(b)) => b - a,
+            _ => 0.0,
+        };
+        reach += len * sin;
+        let lo = (d - reach).max(dmin).min(dmax);
+        let hi = (d + reach).max(dmin).min(dmax);
+        if let (Some(l), Some(u)) = (b.lo.get_mut(j), b.hi.get_mut(j)) {
+            *l = lo;
+            *u = hi;
+        }
+    }
+    b
+}
+
+/// Depths tried on the committed track, with their `J` and minimum
+/// altitudes.
+pub(super) struct ScanLog {
+    z: [f32; MAX_SCAN as usize],
+    j: [f32; MAX_SCAN as usize],
+    alt: [f32; MAX_SCAN as usize],
+    len: usize,
+}
+
+impl Default for ScanLog {
+    fn default() -> Self {
+        Self {
+            z: [0.0; MAX_SCAN as usize],
+            j: [0.0; MAX_SCAN as usize],
+            alt: [0.0; MAX_SCAN as usize],
+            len: 0,
+        }
+    }
+}
+
+impl ScanLog {
+    pub(super) fn push(&mut self, z: f32, s: &TrackScore) {
+        if let (Some(zs), Some(js), Some(a)) = (
+            self.z.get_mut(self.len),
+            self.j.get_mut(self.len),
+            self.alt.get_mut(self.len),
+        ) {
+            *zs = z;
+            *js = s.j();
+            *a = s.min_altitude();
+            self.len = self.len.saturating_add(1);
+        }
+    }
+
+    /// Whether nothing was logged.
+    pub(super) fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// `(z, alt)` of each entry.
+    pub(super) fn iter(&self) -> impl Iterator<Item = (f32, f32)> + '_ {
+        self.z
+            .iter()
+            .copied()
+            .zip(self.alt.iter().copied())
+            .take(self.len)
+    }
+
+    /// The entry `(z, J, alt)` nearest to `z` (m) whose minimum altitude is
+    /// at least `h_safe` (m), if any.
+    pub(super) fn nearest_safe(&self, z: f32, h_safe: f32) -> Option<(f32, f32, f32)> {
+        self.entries()
+            .filter(|e| e.2 >= h_safe)
+            .min_by(|a, b| libm::fabsf(a.0 - z).total_cmp(&libm::fabsf(b.0 - z)))
+    }
+
+    /// The safest entry's depth, m.
+    pub(super) fn safest(&self) -> Option<f32> {
+        self.iter().max_by(|a, b| a.1.total_cmp(&b.1)).map(|e| e.0)
+    }
+
+    /// `(z, J, alt)` of each entry.
+    pub(super) fn entries(&self) -> impl Iterator<Item = (f32, f32, f32)> + '_ {
+        self.z
+            .iter()
+            .copied()
+            .zip(self.j.iter().copied())
+            .zip(self.alt.iter().copied())
+            .map(|((z, j), a)| (z, j, a))
+            .take(self.len)
+    }
+}
+
+/// The scan's result for one track: the best scanned value `phis[i]` and
+/// a parabola through it and its neighbours.
+struct Scanned {
+    /// Objective at each grid point (`+inf` where the flight failed).
+    phis: [f32; MAX_SCAN as usize],
+    /// Whether the penalty acts there (a kink: no parabola through it).
+    kinked: [bool; MAX_SCAN as usize],
+}
+
+/// The start of track `j` of the horizon from the scan: the parabola's
+/// vertex through the best scanned value and its neighbours (a Newton step
+/// for free) and, for a single track, its curvature as BFGS's first metric
+/// (successive parabolic interpolation).
+fn vertex(s: &Scanned, i: usize, lo: f32, hi: f32, n: u32, single: bool) -> (f32, f32) {
+    let h_grid = (hi - lo) / (n.saturating_sub(1).max(1) as f32);
+    let z_best = grid(lo, hi, i as u32, n);
+    let smooth = i.checked_sub(1).is_some_and(|m| {
+        s.kinked
+            .get(m..=i.saturating_add(1))
+            .is_some_and(|w| w.iter().all(|k| !k))
+    });
+    if !smooth {
+        // Keep the scanned depth; the first-step scaling sets A_0.
+        return (z_best, 0.0);
+    }
+    if let (Some(&pm), Some(&p0), Some(&pp)) = (
+        i.checked_sub(1).and_then(|m| s.phis.get(m)),
+        s.phis.get(i),
+        s.phis
+            .get(i.saturating_add(1))
+            .filter(|_| i.saturating_add(1) < n as usize),
+    ) {
+        let second = pp - 2.0 * p0 + pm;
+        if second.is_finite() && second > 0.0 && h_grid > 0.0 {
+            // Per-track curvatures ignore the coupling of a horizon:
+            // there the measured BFGS scaling does better.
+            let c = if single {
+                second / (h_grid * h_grid)
+            } else {
+                0.0
+            };
+            return (z_best - 0.5 * h_grid * (pp - pm) / second, c);
+        }
+    }
+    (z_best, 0.0)
+}
+
+/// What the scan of a horizon needs to know.
+pub(super) struct ScanSpec<'b, const K: usize> {
+    /// The box.
+    pub bounds: &'b Bounds<K>,
+    /// Tracks already started (warm), and the horizon length.
+    pub from: usize,
+    pub h: usize,
+    /// Grid points per track.
+    pub points: u32,
+    /// Penalty weight of the objective scanned.
+    pub mu: f32,
+}
+
+/// Coarse scan of tracks `from..h` of the horizon, each from the state
+/// the best scanned depth of the previous one leaves; fills `z0` and
+/// `curvature`, logs the first track's flights.
+pub(super) fn scan_start<const N: usize, const K: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    spec: &ScanSpec<'_, K>,
+    z0: &mut [f32; K],
+    curvature: &mut [f32; K],
+    log: &mut ScanLog,
+) -> Result<(), PlanError> {
+    // The state at the start of track `from`, along the plan so far.
+    let mut st = *fl.state;
+    for j in 0..spec.from {
+        let z = z0.get(j).copied().unwrap_or(0.0);
+        match fl.fly_from(&st, j, z) {
+            Ok((_, n)) => st = n,
+            Err(e) if j == 0 => return Err(e.into()),
+            Err(_) => break,
+        }
+    }
+    let n = spec.points;
+    for j in spec.from..spec.h {
+        let (lo, hi) = (
+            spec.bounds.lo.get(j).copied().unwrap_or(0.0),
+            spec.bounds.hi.get(j).copied().unwrap_or(0.0),
+        );
+        let mut s = Scanned {
+            phis: [f32::INFINITY; MAX_SCAN as usize],
+            kinked: [true; MAX_SCAN as usize],
+        };
+        let mut best: Option<(usize, VehicleState<N>)> = None;
+        for k in 0..n {
+            let z = grid(lo, hi, k, n);
+            let Ok((sc, next)) = fl.fly_from(&st, j, z) else {
+                continue;
+            };
+            if j == 0 {
+                log.push(z, &sc);
+            }
+            let phi = sc.j() + spec.mu * sc.violation();
+            let i = k as usize;
+            if let Some(p) = s.phis.get_mut(i) {
+                *p = phi;
+            }
+            if let Some(kk) = s.kinked.get_mut(i) {
+                *kk = spec.mu > 0.0 && sc.violation() > 0.0;
+            }
+            if best.is_none_or(|(b, _)| s.phis.get(b).is_none_or(|&pb| phi < pb)) {
+                best = Some((i, next));
+            }
+        }
+        let Some((i, next)) = best else {
+            return Err(PlanError::Sim(crate::sim::SimError::Diverged));
+        };
+        let (z, c) = vertex(&s, i, lo, hi, n, spec.h == 1);
+        if let Some(slot) = z0.get_mut(j) {
+            *slot = z;
+        }
+        if let Some(slot) = curvature.get_mut(j) {
+            *slot = c;
+        }
+        st = next;
+    }
+    Ok(())
+}

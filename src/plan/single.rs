@@ -1,0 +1,189 @@
+//! A constrained single track (track-wise mode, the last track of a
+//! horizon). The scan gives each scanned depth's minimum altitude. When the
+//! scan's best depth is unsafe, or safe with its parabola pointing to an
+//! unsafe neighbour, the optimum of `J` lies beyond the safe set and the
+//! constrained optimum on its boundary next to it: the root search of
+//! [`super::fallback::boundary`] finds it in a few plain flights, and a
+//! finite difference of `J` there confirms that `J` does not decrease into
+//! the safe set (if it does, the optimizer runs from there). With no
+//! scanned depth safe, the track is infeasible.
+
+use crate::optim::Outcome;
+
+use super::fallback::{Flown, boundary, fallback};
+use super::planner::Flights;
+use super::scan::ScanLog;
+use super::{PlanError, PlanStatus};
+
+/// The finite-difference step, m, that checks a boundary optimum (`J` must
+/// not decrease into the safe set).
+const CHECK_STEP: f32 = 2.0;
+
+/// One end of a boundary bracket: a depth (m) and its minimum altitude
+/// (m) when known.
+type End = (f32, Option<f32>);
+
+/// What the scan says of a single track.
+pub(super) enum Decision<const N: usize> {
+    /// Answered without the optimizer.
+    Done(Flown<N>, PlanStatus),
+    /// Optimize, from `z0` (with the scan's curvature unless `flat`).
+    Optimize { z0: f32, flat: bool },
+}
+
+/// Decides from the scanned minimum altitudes whether the optimum lies
+/// beyond the safe set (and answers with the boundary search), whether
+/// nothing is safe (infeasible), or whether the optimizer should run,
+/// possibly from a better start. `vertex` is the scan's start point.
+pub(super) fn decide<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    scan: &ScanLog,
+    vertex: f32,
+    h_safe: f32,
+    steps: u32,
+) -> Result<Decision<N>, PlanError> {
+    match bracket(scan, vertex, h_safe) {
+        Bracket::Infeasible => {
+            let z = scan.safest().unwrap_or(vertex);
+            let (score, next) = fl.fly(z)?;
+            let f = Flown {
+                depth: z,
+                score,
+                next,
+            };
+            Ok(Decision::Done(f, PlanStatus::Infeasible))
+        }
+        Bracket::None => Ok(Decision::Optimize {
+            z0: vertex,
+            flat: false,
+        }),
+        Bracket::Found(good, bad) => {
+            let b = boundary(fl, good, bad, h_safe, steps)?;
+            let z_b = b.at.depth;
+            // Does `J` decrease from the boundary into the safe set? A
+            // finite difference towards the safe side: the search's previous
+            // safe depth when within `CHECK_STEP` (no extra flight), else
+            // one flight there.
+            let inward = good.0 - z_b;
+            let step = CHECK_STEP.min(libm::fabsf(inward)).copysign(inward);
+            let near = b.inner.filter(|p| libm::fabsf(p.0 - z_b) <= CHECK_STEP);
+            let (z_in, j_in) = match near {
+                Some(p) => p,
+                None => {
+                    let z = z_b + step;
+                    (z, fl.fly(z).map_or(f32::INFINITY, |(s, _)| s.j()))
+                }
+            };
+            let slope = (j_in - b.at.score.j()) / (z_in - z_b);
+            if slope * inward < 0.0 {
+                // An interior optimum: optimize from the boundary.
+                Ok(Decision::Optimize {
+                    z0: z_b,
+                    flat: true,
+                })
+            } else {
+                Ok(Decision::Done(b.at, PlanStatus::SafeFallback))
+            }
+        }
+    }
+}
+
+/// What the scan brackets.
+enum Bracket {
+    /// Nothing scanned is safe.
+    Infeasible,
+    /// The optimum may be interior.
+    None,
+    /// (safe end, unsafe end) of the boundary next to the optimum.
+    Found(End, End),
+}
+
+/// A bracket of the boundary when the scan puts the optimum beyond it.
+fn bracket(scan: &ScanLog, vertex: f32, h_safe: f32) -> Bracket {
+    let Some((z_best, _, alt_best)) = scan
+        .entries()
+        .filter(|e| e.1.is_finite())
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+    else {
+        return Bracket::None;
+    };
+    // The scanned neighbour of `from` in the direction of `to`.
+    let neighbour = |from: f32, to: f32| {
+        scan.entries()
+            .filter(|e| (e.0 - from) * (to - from) > 0.0)
+            .min_by(|a, b| libm::fabsf(a.0 - from).total_cmp(&libm::fabsf(b.0 - from)))
+    };
+    if alt_best < h_safe {
+        return match scan.nearest_safe(z_best, h_safe) {
+            Some(sf) => {
+                let unsafe_end =
+                    neighbour(sf.0, z_best).map_or((z_best, Some(alt_best)), |e| (e.0, Some(e.2)));
+                Bracket::Found((sf.0, Some(sf.2)), unsafe_end)
+            }
+            None => Bracket::Infeasible,
+        };
+    }
+    match neighbour(z_best, vertex) {
+        Some(n) if n.2 < h_safe && libm::fabsf(vertex - z_best) > 0.0 => {
+            Bracket::Found((z_best, Some(alt_best)), (n.0, Some(n.2)))
+        }
+        _ => Bracket::None,
+    }
+}
+
+/// The optimizer of a constrained single track left the safe set at
+/// `(z_bad, alt_bad)` (m, m): the optimum lies beyond the boundary it was
+/// descending towards. Searches that boundary between the best safe depth
+/// it evaluated (or else scanned) and the unsafe one; with none safe, the
+/// general fallback. Appends the answer's `J` to `out`'s history (the
+/// boundary search counts as one iteration after the optimizer's).
+#[allow(clippy::too_many_arguments)]
+pub(super) fn tripped<const N: usize, const K: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    (z_bad, alt_bad): (f32, f32),
+    best_safe: Option<(f32, f32, f32)>,
+    out: &mut Outcome<K>,
+    (lo, hi): (f32, f32),
+    h_safe: f32,
+    (scan_points, steps): (u32, u32),
+    scan: &mut ScanLog,
+) -> Result<(Flown<N>, PlanStatus), PlanError> {
+    let good = match best_safe {
+        Some((z, _, alt)) => Some((z, alt)),
+        None => scan.nearest_safe(z_bad, h_safe).map(|e| (e.0, e.2)),
+    };
+    let (f, status) = match good {
+        Some((z_good, alt_good)) => {
+            let b = boundary(
+                fl,
+                (z_good, Some(alt_good)),
+                (z_bad, Some(alt_bad)),
+                h_safe,
+                steps,
+            )?;
+            (b.at, PlanStatus::SafeFallback)
+        }
+        None => {
+            let (f, safe) = fallback(
+                fl,
+                (z_bad, Some(alt_bad)),
+                (lo, hi),
+                h_safe,
+                scan_points,
+                steps,
+                scan,
+            )?;
+            let status = if safe {
+                PlanStatus::SafeFallback
+            } else {
+                PlanStatus::Infeasible
+            };
+            (f, status)
+        }
+    };
+    if !out.history.is_empty() {
+        out.iterations = out.iterations.saturating_add(1);
+    }
+    let _ = out.history.push(f.score.j());
+    Ok((f, status))
+}

@@ -1,0 +1,205 @@
+//! The penalized solve of a horizon: one optimizer run merged onto the
+//! planner's workspace, the sequential penalty stages (N&W §17.1: `μ`
+//! ×100 while the optimum still violates), and the plateau escape.
+
+use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
+use crate::sim::SimError;
+
+use super::objective::{PlanObjective, Stop};
+use super::planner::Setup;
+use super::scan::grid;
+use super::{Method, PlanError, Planner};
+
+/// Factor on `μ` between penalty stages.
+const PENALTY_GROWTH: f32 = 100.0;
+
+/// How [`Planner::optimize_onto`] merges a run.
+#[derive(Clone, Copy)]
+pub(super) enum Merge {
+    /// The first run: replaces.
+    First,
+    /// A continuation of the last run.
+    Continue,
+    /// A restart, kept only if better.
+    IfBetter,
+}
+
+impl<const K: usize> Planner<K> {
+    /// Further penalty stages: each re-solves from the last optimum with
+    /// `μ` a hundred times larger while that optimum still violates, at most
+    /// `penalty_stages` in all (one for a single track, whose boundary
+    /// search finds the safe boundary exactly), all within the one
+    /// iteration cap. Returns the iterations so far.
+    pub(super) fn penalty_stages<const N: usize>(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        s: &Setup<K>,
+        first_step: f32,
+    ) -> Result<u32, PlanError> {
+        let cap = self.cfg.bfgs.max_iterations;
+        let mut iterations = self.work.iterations;
+        let stages = if s.h == 1 { 1 } else { self.cfg.penalty_stages };
+        let max_mu = (1..stages).fold(self.cfg.penalty_weight, |m, _| m * PENALTY_GROWTH);
+        while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 && iterations < cap {
+            obj.mu *= PENALTY_GROWTH;
+            let from = self.work.z;
+            let left = cap.saturating_sub(iterations);
+            let taken = self.optimize_onto(
+                obj,
+                &from,
+                &s.bounds,
+                (first_step, left),
+                &[0.0; K],
+                Merge::Continue,
+            )?;
+            iterations = iterations.saturating_add(taken.unwrap_or(0));
+        }
+        Ok(iterations)
+    }
+
+    /// Plateau escape: a coordinate whose gradient is exactly zero has its
+    /// pitch reference saturated over the whole track, and no gradient
+    /// step will ever move it off that plateau, which need not be the best
+    /// (model contract §10). Scan it over its box, the others held, and
+    /// restart from anything better. Returns the iterations so far (a
+    /// jump counts as one).
+    pub(super) fn escape_plateaus<const N: usize>(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        s: &Setup<K>,
+        first_step: f32,
+        mut iterations: u32,
+    ) -> Result<u32, PlanError> {
+        if s.h <= 1 {
+            return Ok(iterations);
+        }
+        let cap = self.cfg.bfgs.max_iterations;
+        for j in 0..s.h {
+            let Some(z) = self.plateau_jump(obj, &s.bounds, j) else {
+                continue;
+            };
+            // The jump costs one iteration of the cap; none left, no restart.
+            let budget = cap.saturating_sub(iterations).saturating_sub(1);
+            if budget == 0 {
+                break;
+            }
+            let taken = self.optimize_onto(
+                obj,
+                &z,
+                &s.bounds,
+                (first_step, budget),
+                &[0.0; K],
+                Merge::IfBetter,
+            )?;
+            if let Some(taken) = taken {
+                iterations = iterations.saturating_add(taken).saturating_add(1);
+            }
+        }
+        Ok(iterations)
+    }
+
+    /// The best point of a scan of coordinate `j` over its box when its
+    /// gradient is exactly zero, if it beats the optimum by more than the
+    /// stopping threshold.
+    fn plateau_jump<const N: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        bounds: &Bounds<K>,
+        j: usize,
+    ) -> Option<[f32; K]> {
+        let (&lo, &hi) = bounds.lo.get(j).zip(bounds.hi.get(j))?;
+        let out = &self.work;
+        if lo >= hi || out.gradient.get(j).is_none_or(|&g| g != 0.0) {
+            return None;
+        }
+        let mut best: Option<(f32, [f32; K])> = None;
+        for k in 0..self.cfg.scan_points {
+            let mut z = out.z;
+            if let Some(zj) = z.get_mut(j) {
+                *zj = grid(lo, hi, k, self.cfg.scan_points);
+            }
+            if let Ok((phi, _)) = optim::Objective::<K>::eval(obj, &z)
+                && phi < best.as_ref().map_or(out.j, |b| b.0)
+            {
+                best = Some((phi, z));
+            }
+        }
+        best.filter(|b| b.0 < out.j - self.cfg.bfgs.tol.j_threshold(out.j))
+            .map(|b| b.1)
+    }
+
+    /// One optimizer run (BFGS or GD, as configured) on `obj` from `z0`
+    /// with start `curvature` and `(first_step, max_iterations)`, merged
+    /// onto the workspace in place: the first run, a continuation (the next
+    /// penalty stage: its history after its start, whose value the
+    /// workspace ends with) or, with [`Merge::IfBetter`], a restart kept
+    /// only if it ends lower (its whole history). Returns the run's
+    /// iterations, `None` when not kept.
+    pub(super) fn optimize_onto<const N: usize>(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        z0: &[f32; K],
+        bounds: &Bounds<K>,
+        (first_step, max_iterations): (f32, u32),
+        curvature: &[f32; K],
+        merge: Merge,
+    ) -> Result<Option<u32>, PlanError> {
+        let acc = &mut self.work;
+        // What a rejected restart restores (all but the history, which is
+        // truncated back).
+        let kept = (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status);
+        let kept_counts = (
+            acc.iterations,
+            acc.evaluations,
+            acc.skipped_updates,
+            acc.history.len(),
+        );
+        if let Merge::First = merge {
+            acc.history.clear();
+        }
+        let continued = matches!(merge, Merge::Continue);
+        let bfgs = BfgsConfig {
+            first_step,
+            max_iterations,
+            ..self.cfg.bfgs
+        };
+        let run = match self.cfg.method {
+            Method::Bfgs => optim::bfgs::bfgs_into(
+                obj,
+                z0,
+                bounds,
+                &bfgs,
+                &bfgs.armijo,
+                curvature,
+                acc,
+                continued,
+            ),
+            Method::GradientDescent => {
+                let gd = GdConfig {
+                    rate: self.cfg.gd_rate,
+                    max_iterations,
+                    tol: self.cfg.bfgs.tol,
+                };
+                optim::gd::gradient_descent_into(obj, z0, bounds, &gd, acc, continued)
+            }
+        };
+        run.map_err(|e| match e {
+            OptimError::Config(p) => PlanError::Config(p.into()),
+            OptimError::Start(Stop::Sim(e)) => PlanError::Sim(e),
+            OptimError::Start(Stop::LeftSafeSet) | OptimError::NonFinite => {
+                PlanError::Sim(SimError::Diverged)
+            }
+        })?;
+        // (A NaN objective is not better either.)
+        if let Merge::IfBetter = merge
+            && acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less)
+        {
+            (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
+            (acc.iterations, acc.evaluations, acc.skipped_updates) =
+                (kept_counts.0, kept_counts.1, kept_counts.2);
+            acc.history.truncate(kept_counts.3);
+            return Ok(None);
+        }
+        Ok(Some(acc.iterations))
+    }
+}

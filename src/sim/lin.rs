@@ -1,0 +1,64 @@
+//! What one step and one scored piece linearize to: the interface between
+//! the simulation loop and a tangent pass ([`super::tangent`]).
+
+use crate::model::{Command, Vehicle};
+
+/// How the per-step cascade and kinematics linearize, for a tangent pass.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StepLin {
+    /// Index of the active track among the simulated ones.
+    pub slot: usize,
+    pub command: Command,
+    /// `sin θ̄`, `cos θ̄`.
+    pub sin: f32,
+    pub cos: f32,
+}
+
+/// Where one end of a scored piece lies.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum EndAt {
+    /// At the segment's first sample (`b'` there).
+    Start { slope: f32 },
+    /// At the segment's second sample.
+    End { slope: f32 },
+    /// At a fixed waypoint, fraction `t` of the way along the segment.
+    Clip { t: f32 },
+}
+
+/// One end of a scored piece: where, and its `e = d_t − d` and
+/// `p = max(0, h_a − h)` (m).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct End {
+    pub at: EndAt,
+    pub e: f32,
+    pub p: f32,
+}
+
+/// A scored piece of a segment: its length (m), the segment's `Δx`, `Δd`
+/// (m) and its two ends.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PieceLin {
+    pub len: f32,
+    pub dx: f32,
+    pub dd: f32,
+    pub lo: End,
+    pub hi: End,
+}
+
+/// Receives the linearization of a run as it happens.
+pub(crate) trait Sensitivity<const N: usize> {
+    /// After step `k` has moved the state to sample `k + 1`.
+    fn step(&mut self, vehicle: &Vehicle<N>, lin: &StepLin);
+    /// After a piece of the newest segment was scored into track `slot`.
+    fn piece(&mut self, slot: usize, lin: &PieceLin);
+}
+
+/// The plain simulation's hook: does nothing, and compiles to nothing.
+pub(crate) struct NoSensitivity;
+
+impl<const N: usize> Sensitivity<N> for NoSensitivity {
+    #[inline(always)]
+    fn step(&mut self, _: &Vehicle<N>, _: &StepLin) {}
+    #[inline(always)]
+    fn piece(&mut self, _: usize, _: &PieceLin) {}
+}

@@ -1,0 +1,556 @@
+//! The simulation loop: the vehicle flying its next tracks (model
+//! contract §3, §6, §7), scored as it goes (§8).
+//!
+//! One step, in the contract's order:
+//! 1. the active reference `r_k = z_n` for `X_{n-1} <= x_k < X_n`;
+//! 2. the autopilot cascade gives `δ_k`, then updates its integrators;
+//! 3. `η_{k+1} = Ad η_k + Bd δ_k`;
+//! 4. kinematics along the mean pitch `θ̄ = (θ_k + θ_{k+1}) / 2`:
+//!    `d += -U0 Ts sin θ̄`, `x += U0 Ts cos θ̄`;
+//! 5. `d_{k-1} <- d_k`.
+//!
+//! A run over tracks `first..first+m` starts from a state on track `first`
+//! and ends at the first sample with `x >= X_{first+m}`; that final state is
+//! exactly the start state of the next track. Each segment between two
+//! samples is scored into the tracks it overlaps as it is flown, so a run
+//! costs one pass and no trajectory storage.
+//!
+//! The loop is written once. A `Sensitivity` hook receives what each step
+//! and each scored segment linearize to; the plain simulation passes a
+//! no-op that compiles away, the gradient ([`crate::gradient`]) propagates
+//! tangents in the same pass.
+
+use crate::model::Cursor;
+use crate::num::{DEG, max, min};
+
+use super::lin::{NoSensitivity, Sensitivity, StepLin};
+use super::score::{At, Geo, piece_within, shortfall, trapezoid};
+use super::{Sample, Scenario, SimError, TrackScore, VehicleState};
+
+/// Most steps of one run of the simulation's fast path (see `run`).
+const FAST_RUN: f32 = 256.0;
+
+/// What a run carries from step to step.
+struct Flight<const N: usize> {
+    st: VehicleState<N>,
+    /// θ_k: computed once per step, as θ_{k+1} of the step before, deg.
+    pitch: f32,
+    /// `d_k − d_{k−1}`, m.
+    rise: f32,
+    /// Steps left before the run is declared stuck.
+    budget: u32,
+    cursor: Cursor,
+    /// The current sample's geometry.
+    cur: Geo,
+    /// The active track, and `X_{track+1}` where it ends, m.
+    track: usize,
+    track_end: f32,
+    /// Where the run ends, m.
+    x_end: f32,
+}
+
+/// The end of a run: finite scores and a finite end state, or
+/// [`SimError::Diverged`]. Finite inputs of absurd magnitude (a bottom
+/// 10¹⁸ m down) can overflow `J` or the violation; an absurd but finite
+/// reference (10³⁸ m) can drive an integrator out of range without
+/// upsetting the flight, which the clamps keep finite. (Position and depth
+/// are finite, or the flight would have failed.)
+#[inline(always)]
+fn finish<const N: usize>(
+    st: VehicleState<N>,
+    scores: &[TrackScore],
+) -> Result<VehicleState<N>, SimError> {
+    if scores
+        .iter()
+        .any(|s| !(s.min_altitude.is_finite() && s.j().is_finite() && s.violation().is_finite()))
+    {
+        return Err(SimError::Diverged);
+    }
+    if !(st.depth_integral.is_finite()
+        && st.pitch_integral.is_finite()
+        && st.eta.iter().all(|v| v.is_finite()))
+    {
+        return Err(SimError::Diverged);
+    }
+    Ok(st)
+}
+
+impl<const N: usize> Scenario<'_, N> {
+    /// Flies tracks `first_track..first_track + depths.len()` with one
+    /// reference depth per track (m) from `start`, scoring each track into
+    /// `scores` and handing every sample to `observe`. Returns the state at
+    /// the first sample past the last of those tracks.
+    ///
+    /// # Errors
+    /// [`SimError`] for bad arguments or a flight that diverges.
+    pub fn simulate<F: FnMut(&Sample)>(
+        &self,
+        start: &VehicleState<N>,
+        first_track: usize,
+        depths: &[f32],
+        scores: &mut [TrackScore],
+        observe: F,
+    ) -> Result<VehicleState<N>, SimError> {
+        self.run::<_, _, true>(
+            start,
+            first_track,
+            depths,
+            scores,
+            &mut NoSensitivity,
+            observe,
+        )
+    }
+
+    /// The one simulation loop; see the module docs. `FAST` selects the
+    /// in-segment fast path (always, but for the test that compares the
+    /// two paths).
+    #[inline(always)]
+    pub(crate) fn run<Sn: Sensitivity<N>, F: FnMut(&Sample), const FAST: bool>(
+        &self,
+        start: &VehicleState<N>,
+        first: usize,
+        depths: &[f32],
+        scores: &mut [TrackScore],
+        sens: &mut Sn,
+        mut observe: F,
+    ) -> Result<VehicleState<N>, SimError> {
+        let (last, scores) = self.prepare(start, first, depths, scores)?;
+        let mut fl = self.begin(start, first, last, scores, sens)?;
+        loop {
+            // A sample whose step needs the general treatment: the end of
+            // the run, a waypoint switch, a new bottom segment, a sample
+            // not scored.
+            if fl.cur.past >= 0.0 {
+                let plant = self.vehicle.plant();
+                observe(&Sample {
+                    x: fl.st.x(),
+                    depth: fl.st.depth(),
+                    pitch: fl.pitch,
+                    pitch_rate: plant.pitch_rate_v(&fl.st.eta),
+                    reference: None,
+                    command: None,
+                });
+                break;
+            }
+            let wp = self.waypoints.positions();
+            while fl.track.saturating_add(1) < last && fl.st.x.minus(fl.track_end) >= 0.0 {
+                fl.track = fl.track.saturating_add(1);
+                fl.track_end = *wp
+                    .get(fl.track.saturating_add(1))
+                    .ok_or(SimError::TrackRange)?;
+            }
+            let slot = fl.track.saturating_sub(first);
+            let r = *depths.get(slot).ok_or(SimError::TrackRange)?;
+            match fl.cur.at {
+                Some(a0) if FAST && fl.st.x.minus(fl.track_end) < 0.0 => {
+                    let score = scores.get_mut(slot).ok_or(SimError::ScoreBuffer)?;
+                    self.fast_run(&mut fl, a0, r, slot, score, sens, &mut observe)?;
+                }
+                _ => {
+                    fl.budget = fl.budget.checked_sub(1).ok_or(SimError::StepLimit)?;
+                    let at = (&mut fl.st, &mut fl.pitch, &mut fl.rise);
+                    self.advance(at, (r, fl.track, slot), sens, &mut observe)?;
+                }
+            }
+            // The step just taken, the general way.
+            let prev = fl.cur;
+            fl.cur = self.geo(&mut fl.cursor, fl.st.x, fl.st.depth, fl.x_end)?;
+            self.score(&prev, &fl.cur, fl.track, first, last, scores, sens)?;
+        }
+        finish(fl.st, scores)
+    }
+
+    /// Checks a run's arguments and resets its scores; returns the index
+    /// of the waypoint it ends at and the scores it fills.
+    #[inline(always)]
+    fn prepare<'s>(
+        &self,
+        start: &VehicleState<N>,
+        first: usize,
+        depths: &[f32],
+        scores: &'s mut [TrackScore],
+    ) -> Result<(usize, &'s mut [TrackScore]), SimError> {
+        let wp = self.waypoints.positions();
+        let last = first
+            .checked_add(depths.len())
+            .filter(|&l| l > first && l < wp.len())
+            .ok_or(SimError::TrackRange)?;
+        let scores = scores
+            .get_mut(..depths.len())
+            .ok_or(SimError::ScoreBuffer)?;
+        for (i, s) in scores.iter_mut().enumerate() {
+            let t = first.saturating_add(i);
+            let a = wp.get(t).copied().unwrap_or(0.0);
+            let b = wp.get(t.saturating_add(1)).copied().unwrap_or(0.0);
+            *s = TrackScore::new(a, b);
+        }
+        if let Some(index) = depths.iter().position(|z| !z.is_finite()) {
+            return Err(SimError::NonFiniteDepth { index });
+        }
+        self.check_start(start, first)?;
+        Ok((last, scores))
+    }
+
+    /// The run's state at its start sample, with the piece of the first
+    /// track flown before it scored.
+    #[inline(always)]
+    fn begin<Sn: Sensitivity<N>>(
+        &self,
+        start: &VehicleState<N>,
+        first: usize,
+        last: usize,
+        scores: &mut [TrackScore],
+        sens: &mut Sn,
+    ) -> Result<Flight<N>, SimError> {
+        let wp = self.waypoints.positions();
+        let x_begin = *wp.get(first).ok_or(SimError::TrackRange)?;
+        let x_end = *wp.get(last).ok_or(SimError::TrackRange)?;
+        let track_end = *wp
+            .get(first.saturating_add(1))
+            .ok_or(SimError::TrackRange)?;
+        let plant = self.vehicle.plant();
+        let step_len = self.vehicle.speed() * plant.sample_time();
+        // Even flying at 75° on average the line would be done by then.
+        let max_steps = 4.0 * (x_end - start.x()) / step_len + 100.0;
+        let st = *start;
+        let mut cursor = Cursor::default();
+        let cur = self.geo(&mut cursor, st.x, st.depth, x_end)?;
+        if st.x_prev.diff(st.x) < 0.0 {
+            let mut c0 = Cursor::default();
+            let prev = if st.x_prev.minus(x_begin) >= 0.0 {
+                self.geo(&mut c0, st.x_prev, st.depth_prev, x_end)?
+            } else {
+                Geo {
+                    x: st.x_prev,
+                    d: st.depth_prev,
+                    at: None,
+                    past: st.x_prev.minus(x_end),
+                }
+            };
+            self.score(&prev, &cur, first, first, last, scores, sens)?;
+        } else if let (Some(a), Some(s)) = (cur.at, scores.first_mut()) {
+            s.min_altitude = min(s.min_altitude, a.h);
+        }
+        Ok(Flight {
+            st,
+            pitch: plant.pitch_v(&st.eta),
+            rise: st.depth.diff(st.depth_prev),
+            budget: if max_steps.is_finite() {
+                max_steps as u32
+            } else {
+                u32::MAX
+            },
+            cursor,
+            cur,
+            track: first,
+            track_end,
+            x_end,
+        })
+    }
+
+    /// The fast path: from a scored sample `a0` inside the track, as long
+    /// as each new sample lands short of `fast_limit` it lies on the active
+    /// track, before the line's end and on the bottom segment the cursor
+    /// holds, and the segment it ends is scored wholly into this track,
+    /// with its running score kept in registers. The limit is a few ulps
+    /// and a millimetre short of the next event, so that its plain f32
+    /// compare never decides a case the exact (compensated) tests would
+    /// decide otherwise. Leaves `fl.cur` at the sample before the one that
+    /// left the fast path, for the general path to score that step.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn fast_run<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
+        &self,
+        fl: &mut Flight<N>,
+        mut a0: At,
+        r: f32,
+        slot: usize,
+        score: &mut TrackScore,
+        sens: &mut Sn,
+        observe: &mut F,
+    ) -> Result<(), SimError> {
+        let (h_r, h_p) = (self.mission.reference_altitude(), self.penalty_altitude);
+        // A run is also cut after about `FAST_RUN` steps, so that its plain
+        // partial sum of `J` (added to the track's compensated sum when the
+        // run ends) adds up at most that many terms: relative error below
+        // `FAST_RUN` ε/2.
+        let horizon =
+            fl.st.x.value() + FAST_RUN * self.vehicle.speed() * self.vehicle.plant().sample_time();
+        let event = min(min(fl.track_end, fl.cursor.end()), horizon);
+        let fast_limit = event - (1e-3 + 4.0 * f32::EPSILON * libm::fabsf(event));
+        let mut acc = *score;
+        let mut j_run = 0.0_f32;
+        let mut e2 = a0.e * a0.e;
+        let mut guard = if a0.p > 0.0 {
+            f32::INFINITY
+        } else {
+            max(acc.min_altitude, h_p)
+        };
+        let mut fast = false;
+        // The flight's state in locals, for registers in the loop.
+        let (mut st, mut pitch, mut rise, mut budget) = (fl.st, fl.pitch, fl.rise, fl.budget);
+        let (cursor, track) = (fl.cursor, fl.track);
+        loop {
+            // On an error the run is lost, but its score so far is kept.
+            let Some(left) = budget.checked_sub(1) else {
+                acc.j.add(0.25 * j_run);
+                *score = acc;
+                return Err(SimError::StepLimit);
+            };
+            budget = left;
+            let at = (&mut st, &mut pitch, &mut rise);
+            let (dx, dd) = match self.advance(at, (r, track, slot), sens, observe) {
+                Ok(v) => v,
+                Err(e) => {
+                    acc.j.add(0.25 * j_run);
+                    *score = acc;
+                    return Err(e);
+                }
+            };
+            // (NaN leaves the fast path too.)
+            if st.x.value().partial_cmp(&fast_limit) != Some(core::cmp::Ordering::Less) {
+                break;
+            }
+            fast = true;
+            // Δx and Δd are the step's exact increments; the new sample is
+            // on the cursor's segment: no lookup.
+            let p1 = cursor.point(st.x);
+            // `p` is computed only where the sample can matter (below).
+            let mut a1 = At::clear(p1.altitude(st.depth), p1.slope, h_r);
+            let e2_next = a1.e * a1.e;
+            // (The trapezoid's ¼ is applied to the run's sum: a power of
+            // two, so exactly the same.)
+            j_run += trapezoid(dx, e2, e2_next);
+            // One compare in the common case: a sample at or above `guard`
+            // sets no new minimum and does not violate, and `guard` is +inf
+            // after a violating sample, so that the violation's next
+            // trapezoid is taken here too.
+            if a1
+                .h
+                .partial_cmp(&guard)
+                .is_none_or(|o| o == core::cmp::Ordering::Less)
+            {
+                a1.p = shortfall(a1.h, h_p);
+                if a0.p > 0.0 || a1.p > 0.0 {
+                    acc.violation
+                        .add(0.25 * trapezoid(dx, a0.p * a0.p, a1.p * a1.p));
+                }
+                // The segment's first sample was counted as the last one's
+                // end.
+                acc.min_altitude = min(acc.min_altitude, a1.h);
+                guard = if a1.p > 0.0 {
+                    f32::INFINITY
+                } else {
+                    max(acc.min_altitude, h_p)
+                };
+            }
+            sens.piece(slot, &piece_within(dx, dd, &a0, &a1));
+            e2 = e2_next;
+            a0 = a1;
+        }
+        acc.j.add(0.25 * j_run);
+        *score = acc;
+        (fl.st, fl.pitch, fl.rise, fl.budget) = (st, pitch, rise, budget);
+        if fast {
+            // The sample before the one that left the fast path.
+            fl.cur = Geo {
+                x: fl.st.x_prev,
+                d: fl.st.depth_prev,
+                at: Some(a0),
+                past: -1.0,
+            };
+        }
+        Ok(())
+    }
+
+    /// Whether `start` can start a run on track `first`: finite, and at
+    /// `X_first <= x < X_first+1`.
+    ///
+    /// # Errors
+    /// [`SimError::TrackRange`], [`SimError::NonFiniteState`] or
+    /// [`SimError::StateOffTrack`].
+    pub(crate) fn check_start(
+        &self,
+        start: &VehicleState<N>,
+        first: usize,
+    ) -> Result<(), SimError> {
+        let wp = self.waypoints.positions();
+        let x_begin = *wp.get(first).ok_or(SimError::TrackRange)?;
+        let x_next = *wp
+            .get(first.saturating_add(1))
+            .ok_or(SimError::TrackRange)?;
+        if !start.is_finite() {
+            return Err(SimError::NonFiniteState);
+        }
+        if !(start.x.minus(x_begin) >= 0.0 && start.x.minus(x_next) < 0.0) {
+            return Err(SimError::StateOffTrack);
+        }
+        Ok(())
+    }
+
+    /// One step of the loop (contract §7, steps 2–5) from the flight's
+    /// state, on reference `r` of its active track: the cascade, the plant,
+    /// the kinematics. Moves the state, pitch and rise to sample `k + 1`,
+    /// hands sample `k` to `observe` and the linearization to `sens`;
+    /// returns the increments `(Δx, Δd)`, m.
+    #[inline(always)]
+    fn advance<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
+        &self,
+        (st, pitch, rise): (&mut VehicleState<N>, &mut f32, &mut f32),
+        (r, track, slot): (f32, usize, usize),
+        sens: &mut Sn,
+        observe: &mut F,
+    ) -> Result<(f32, f32), SimError> {
+        let plant = self.vehicle.plant();
+        let ts = plant.sample_time();
+        let pitch_rate = plant.pitch_rate_v(&st.eta);
+        let e_d = -st.depth.minus(r);
+        // `d_k − d_{k−1}` is the last step's `Δd`: `depth` was `depth_prev`
+        // plus it, exactly to the rounding of the compensation term.
+        let depth_rate = *rise / ts;
+        let command = self.vehicle.autopilot().cascade(
+            &mut st.depth_integral,
+            &mut st.pitch_integral,
+            e_d,
+            depth_rate,
+            *pitch,
+            pitch_rate,
+        );
+        observe(&Sample {
+            x: st.x(),
+            depth: st.depth(),
+            pitch: *pitch,
+            pitch_rate,
+            reference: Some((track, r)),
+            command: Some(command),
+        });
+        let eta = plant.step_v(&st.eta, command.elevator);
+        let pitch_next = plant.pitch_v(&eta);
+        let mean = (*pitch + pitch_next) * (0.5 * DEG);
+        // A cruising vehicle's mean pitch is within ±45°: the short
+        // polynomials, whose results are finite with `cos > 0`. Beyond (or
+        // NaN, from a diverging loop), the checked general case.
+        let abs = libm::fabsf(mean);
+        let (sin, cos) = if abs <= crate::num::SHORT {
+            crate::num::sin_cos_short(mean)
+        } else {
+            // Inline, not a call: a call in the loop would cost register
+            // spills on every step.
+            let (sin, cos) = crate::num::sin_cos_long(mean);
+            // Beyond ±90° (or NaN) the vehicle flies backwards: the loop
+            // has diverged. (NaN fails the compare too.)
+            if !(abs <= core::f32::consts::FRAC_PI_2 && cos > 0.0) {
+                return Err(SimError::Diverged);
+            }
+            (sin, cos)
+        };
+        // With `r`, `d` and `Δd` finite, `e_d` and so `I_d` are.
+        let step_len = self.vehicle.speed() * ts;
+        let dx = step_len * cos;
+        let dd = -step_len * sin;
+        st.eta = eta;
+        *pitch = pitch_next;
+        st.depth_prev = st.depth;
+        st.x_prev = st.x;
+        st.depth = st.depth.add(dd);
+        st.x = st.x.add(dx);
+        *rise = dd;
+        sens.step(
+            self.vehicle,
+            &StepLin {
+                slot,
+                command,
+                sin,
+                cos,
+            },
+        );
+        Ok((dx, dd))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The fast in-segment path against the general path, on random
+    //! flights: the same flight bit for bit (the fast path only scores
+    //! differently), the same minimum altitude, and `J` and the violation
+    //! equal to their summation's rounding.
+    use super::*;
+    use crate::model::{Mission, Profile, Vehicle, Waypoints};
+
+    struct Lcg(u64);
+    impl Lcg {
+        fn next(&mut self) -> f32 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    #[test]
+    fn fast_path_equals_general_path_on_random_flights() {
+        let vehicle = Vehicle::c_auv4().unwrap();
+        let mut rng = Lcg(20261201);
+        let mut flown = 0;
+        for case in 0..200 {
+            let n = 8 + (rng.next() * 40.0) as usize;
+            let mut x = [0.0_f32; 48];
+            let mut b = [0.0_f32; 48];
+            let mut depth = 200.0 + 800.0 * rng.next();
+            for i in 0..n {
+                x[i] = if i == 0 {
+                    0.0
+                } else {
+                    x[i - 1] + 5.0 + 120.0 * rng.next()
+                };
+                depth += (rng.next() - 0.5) * 60.0;
+                b[i] = depth.max(30.0);
+            }
+            let bottom = Profile::<48>::new(&x[..n], &b[..n]).unwrap();
+            let len = x[n - 1];
+            let m = 2 + (rng.next() * 3.0) as usize;
+            let wx: [f32; 5] =
+                core::array::from_fn(|i| 0.98 * len * (i.min(m) as f32) / (m as f32));
+            let wps = Waypoints::<5>::new(&wx[..=m]).unwrap();
+            let h_a = 5.0 + 40.0 * rng.next();
+            let mission = Mission::new(h_a + 30.0 * rng.next(), h_a, [0.0, 6000.0]).unwrap();
+            let sc = Scenario::new(&vehicle, &bottom, &wps, mission).unwrap();
+            let start = sc.start_state(sc.default_initial_depth());
+            let z: [f32; 4] =
+                core::array::from_fn(|i| b[(i * n / 4).min(n - 1)] - 100.0 * rng.next());
+            let (mut fast, mut general) = ([TrackScore::default(); 4], [TrackScore::default(); 4]);
+            let zs = &z[..m];
+            let a = sc.run::<_, _, true>(&start, 0, zs, &mut fast, &mut NoSensitivity, |_| {});
+            let g = sc.run::<_, _, false>(&start, 0, zs, &mut general, &mut NoSensitivity, |_| {});
+            let (a, g) = match (a, g) {
+                (Ok(a), Ok(g)) => (a, g),
+                (a, g) => {
+                    assert_eq!(a.err(), g.err(), "case {case}");
+                    continue;
+                }
+            };
+            assert_eq!(a, g, "case {case}: end states differ");
+            flown += 1;
+            for (f, s) in fast.iter().zip(&general).take(m) {
+                assert_eq!(f.min_altitude(), s.min_altitude(), "case {case}");
+                let tol = |v: f32| 1e-5 * v.abs() + 1e-6;
+                assert!(
+                    (f.j() - s.j()).abs() <= tol(s.j()),
+                    "case {case}: J {} vs {}",
+                    f.j(),
+                    s.j()
+                );
+                assert!(
+                    (f.violation() - s.violation()).abs() <= tol(s.violation()),
+                    "case {case}: violation {} vs {}",
+                    f.violation(),
+                    s.violation()
+                );
+            }
+        }
+        // Most random flights complete (a few dive into the rock and stop
+        // with the same error both ways).
+        assert!(flown >= 150, "{flown} flights completed");
+    }
+}
