@@ -227,7 +227,7 @@ def test_corner_count():
     assert len(W.corner_bottoms(only_drift, 0.0)) == 4
     assert len(W.corner_motions(only_drift, U0)) == 1
     ms, bs = W.sample_worlds(only_w, U0, 0.0, 1000.0, 5, 0)
-    assert len(ms) == 1 + 2 + 5 and len(bs) == 1 + 1  # no random bottoms
+    assert len(ms) == 1 + 2 + 5 and len(bs) == 1  # only the nominal bottom
 
 
 def test_bounds_from_config():

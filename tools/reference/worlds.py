@@ -450,8 +450,9 @@ def sample_worlds(bounds: Bounds, U0: float, X0: float, XM: float, n_random: int
     motions += corner_motions(bounds, U0)
     if bounds.eps_U or bounds.alpha_max or bounds.w_max:
         motions += random_motions(bounds, U0, n_random, rng)
-    bottoms += corner_bottoms(bounds, X0)
-    bottoms += random_bottoms(bounds, X0, XM, n_random, rng)
+    if bounds.e_h or bounds.r or bounds.e_v:
+        bottoms += corner_bottoms(bounds, X0)
+        bottoms += random_bottoms(bounds, X0, XM, n_random, rng)
     # drop duplicates of the nominal (zero-bound corners)
     seen, ms = set(), []
     for m in motions:
