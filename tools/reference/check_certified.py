@@ -288,7 +288,78 @@ def check_case(c, mode, a, base):
     return lines, npass, nfail, rec
 
 
+# --------------------------------------------------------------------------
+# Stand-in tools for --self-test (no Rust needed)
+# --------------------------------------------------------------------------
+
+
+def stand_in(kind, argv):
+    """A toy `plan --json`: z_n = shallowest target over track n (b - h_r).
+
+    kind "nominal": safe and certified_min_altitude from the nominal flight
+    only (ignores the declared bounds: must be caught when bounds are set).
+    kind "certified": certified_min_altitude = least altitude over its own
+    corner worlds minus 0.5 m (exact when no bound is declared), safe = that
+    >= h_a (honest, with the margin standing in for the random worlds it does
+    not sample: must pass)."""
+    p = argparse.ArgumentParser()
+    for k in ("--profile", "--waypoints", "--config", "--mode"):
+        p.add_argument(k)
+    p.add_argument("--json", action="store_true")
+    o = p.parse_args(argv)
+    prof = ar.Profile.from_csv(o.profile)
+    X = ref_plan.load_waypoints(o.waypoints)
+    full = ref_plan.load_config(o.config)
+    bd = {k: full.pop(k) for k in list(full) if k in W.UNCERTAINTY_KEYS}
+    bounds = W.Bounds.from_config(bd)
+    veh = ar.Vehicle.from_config(full)
+    h_r, h_a = veh.reference_altitude, veh.min_altitude
+    z = []
+    for n in range(1, len(X)):
+        a, b = X[n - 1], X[n]
+        pts = [a, b] + [x for x in prof.x if a < x < b]
+        z.append(min(prof(x) for x in pts) - h_r)
+    d0 = veh.resolved_initial_depth(prof, X[0])
+    _, res = ar.evaluate_plan(veh, prof, X, z)
+    if kind == "certified":
+        worst, _ = W.worst_case(veh, prof, X, z, d0, bounds, 0, "stand-in")
+        margin = 0.0 if bounds.is_zero() else 0.5
+        cert = [w[0] - margin for w in worst]
+    else:
+        cert = [t["min_altitude"] for t in res["tracks"]]
+    tracks = []
+    for t, zn, cm in zip(res["tracks"], z, cert):
+        tracks.append({"track": t["track"], "x_start": t["x_start"], "x_end": t["x_end"],
+                       "depth": zn, "J": t["J"], "rms": t["rms"],
+                       "min_altitude": t["min_altitude"], "safe": cm >= h_a,
+                       "status": "optimal" if cm >= h_a else "infeasible",
+                       "certified_min_altitude": cm})
+    print(json.dumps({"method": "stand-in", "mode": o.mode, "tracks": tracks,
+                      "total_J": res["total_J"], "min_altitude": res["min_altitude"],
+                      "safe": all(t["safe"] for t in tracks)}))
+    return 0
+
+
+def self_test(a):
+    """The honest stand-in passes; the nominal-only one is caught."""
+    me = shlex.join([sys.executable, os.path.abspath(__file__)])
+    common = ["--cases", "4", "--bounds-per-profile", "1", "--random-worlds", "4",
+              "--only", "us_monterey_canyon_1", "es_medes_islands_1",
+              "synthetic_000", "synthetic_001", "synthetic_002", "synthetic_003",
+              "--jobs", str(a.jobs), "--seed", str(a.seed)]
+    print("== self-test: honest stand-in (must pass)", flush=True)
+    rc1 = main(["--bin-cmd", f"{me} --stand-in certified"] + common)
+    print("== self-test: nominal-only stand-in (must be caught)", flush=True)
+    rc2 = main(["--bin-cmd", f"{me} --stand-in nominal"] + common)
+    ok = rc1 == 0 and rc2 == 1
+    print(f"self-test {'passed' if ok else 'FAILED'} (honest rc {rc1}, nominal-only rc {rc2})")
+    return 0 if ok else 1
+
+
 def main(argv=None):
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv[:1] == ["--stand-in"]:
+        return stand_in(argv[1], argv[2:])
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0],
                                  formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=__doc__)
@@ -314,7 +385,11 @@ def main(argv=None):
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--keep", metavar="DIR")
     ap.add_argument("--json-out", metavar="FILE")
+    ap.add_argument("--self-test", action="store_true",
+                    help="check this checker with two stand-in tools (no Rust)")
     a = ap.parse_args(argv)
+    if a.self_test:
+        return self_test(a)
 
     cases = make_cases(a)
     modes = [m.strip() for m in a.modes.split(",") if m.strip()]
