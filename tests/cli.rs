@@ -463,3 +463,370 @@ fn main_job_prints_a_table() {
     );
     assert!(text.contains("total J"));
 }
+
+/// Runs the tool, expects exit status 0 and one `warning:` line on stderr
+/// that mentions `must_mention`; returns stdout.
+fn warns(args: &[&str], must_mention: &str) -> String {
+    let out = run(args);
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(0), "args {args:?}: stderr {err}");
+    let lines: Vec<&str> = err.trim_end().lines().collect();
+    assert_eq!(lines.len(), 1, "not one line: {err:?}");
+    assert!(lines[0].starts_with("warning: "), "{err:?}");
+    assert!(
+        err.to_lowercase().contains(&must_mention.to_lowercase()),
+        "{args:?}: {err:?} should mention {must_mention:?}"
+    );
+    String::from_utf8(out.stdout).unwrap()
+}
+
+fn with_config(profile: &str, toml: &str, extra: &[&str]) -> Vec<String> {
+    let c = tmp(&format!("c{}.toml", fxhash(toml)), toml);
+    let mut e = vec!["--config", c.to_str().unwrap()];
+    e.extend(extra);
+    with(profile, WAYPOINTS, &e)
+}
+
+#[test]
+fn uncertainty_keys_are_parsed_and_validated() {
+    let all = "horizontal_uncertainty = 5.0\nnav_drift = 0.002\nvertical_uncertainty = 2.0\n\
+               speed_uncertainty = 0.1\nflight_path_offset = 3.0\nvertical_current = 0.05\n";
+    // Accepted; the planner does not use them yet, and says so.
+    let a = with_config(PROFILE, all, &["--depths", "20,20"]);
+    warns(&refs(&a), "not yet used by the planner");
+    // All zero is the nominal model: no warning.
+    let zero = "horizontal_uncertainty = 0.0\nnav_drift = 0\nvertical_uncertainty = 0\n\
+                speed_uncertainty = 0\nflight_path_offset = 0\nvertical_current = 0\n";
+    let a = with_config(PROFILE, zero, &["--depths", "20,20"]);
+    let out = run(&refs(&a));
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for key in [
+        "horizontal_uncertainty",
+        "nav_drift",
+        "vertical_uncertainty",
+        "speed_uncertainty",
+        "flight_path_offset",
+        "vertical_current",
+    ] {
+        let a = with_config(PROFILE, &format!("{key} = -0.5\n"), &["--depths", "20,20"]);
+        bad(&refs(&a), &format!("{key} = -0.5 must be >= 0"));
+        let a = with_config(PROFILE, &format!("{key} = nan\n"), &["--depths", "20,20"]);
+        bad(&refs(&a), &format!("{key} = NaN is not finite"));
+    }
+    let a = with_config(PROFILE, "speed_uncertainty = 1.0\n", &["--depths", "20,20"]);
+    bad(&refs(&a), "speed_uncertainty = 1 must be below 1");
+    let a = with_config(
+        PROFILE,
+        "flight_path_offset = 25.0\n",
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "below pitch_limit = 25");
+    let a = with_config(
+        PROFILE,
+        "pitch_limit = 10.0\nflight_path_offset = 12.0\n",
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "below pitch_limit = 10");
+    // Unknown keys stay errors, and the message lists the new keys.
+    let a = with_config(PROFILE, "nav_drfit = 0.1\n", &["--depths", "20,20"]);
+    let err = bad(&refs(&a), "unknown field `nav_drfit`");
+    assert!(err.contains("nav_drift"), "{err}");
+}
+
+#[test]
+fn depth_limits_must_be_a_pair() {
+    for (text, n) in [
+        ("depth_limits = [0.0, 100.0, 200.0]\n", 3),
+        ("depth_limits = [0.0]\n", 1),
+        ("depth_limits = []\n", 0),
+    ] {
+        let a = with_config(PROFILE, text, &["--depths", "20,20"]);
+        let err = bad(
+            &refs(&a),
+            &format!("depth_limits must be a pair [min, max] of depths in m, got {n} values"),
+        );
+        assert!(err.contains(".toml"), "names the file: {err}");
+    }
+}
+
+#[test]
+fn config_line_numbers_are_one_based() {
+    for (text, line) in [
+        ("sped = 1.5\n", 1),
+        ("speed = 1.5\nsped = 1\n", 2),
+        ("speed = 1.5\n\nsped = 1\n", 3),
+        ("# vehicle\n\n\n[depth_pid]\nkp = 1\n\nkpp = 2\n", 7),
+        ("speed = 1.5\n\n\nspeed = 2\n", 4),
+    ] {
+        let c = tmp("lines.toml", text);
+        let a = with(
+            PROFILE,
+            WAYPOINTS,
+            &["--config", c.to_str().unwrap(), "--depths", "20,20"],
+        );
+        bad(&refs(&a), &format!("lines.toml:{line}:"));
+    }
+}
+
+#[test]
+fn csv_line_numbers_count_blank_lines() {
+    // Lines as an editor shows them: blank lines are skipped but counted.
+    let a = with(
+        "x_m,bottom_depth_m\n\n0,100\n100,110\n100,90\n300,100\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), ":5: x_m 100 does not increase");
+    let a = with(
+        "x_m,bottom_depth_m\n0,100\n\n100,110\n\n300,abc\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), ":6: bottom_depth_m 'abc'");
+    let a = with(
+        "\n\nx,depth\n0,100\n100,100\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), ":3: header must name column 'x_m'");
+    let a = with(
+        PROFILE,
+        "wp,x_m\n0,0\n\n1,200\n2,150\n",
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), ":5: x_m 150 does not increase");
+}
+
+#[test]
+fn elevations_are_not_depths() {
+    let gebco = "x_m,bottom_depth_m\n0,-100\n100,-110\n200,-90\n300,-100\n";
+    let a = with(gebco, WAYPOINTS, &["--depths", "20,20"]);
+    let err = bad(&refs(&a), "look like elevations");
+    assert!(err.contains("negate"), "{err}");
+    assert!(err.contains("4 of 4"), "{err}");
+    // Mostly negative is elevations too.
+    let a = with(
+        "x_m,bottom_depth_m\n0,-100\n100,-110\n200,-90\n300,100\n",
+        WAYPOINTS,
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "3 of 4 bottom_depth_m values are negative");
+}
+
+#[test]
+fn impossible_start() {
+    // h_r larger than the water depth at the start: the default start
+    // depth b(X0) - h_r would be above the surface.
+    let shallow = "x_m,bottom_depth_m\n0,50\n100,110\n200,90\n300,100\n";
+    let a = with(shallow, WAYPOINTS, &["--depths", "20,20"]);
+    let err = bad(
+        &refs(&a),
+        "reference_altitude = 80 m is larger than the water depth 50 m",
+    );
+    assert!(err.contains("above the surface"), "{err}");
+    let a = with_config(
+        PROFILE,
+        "reference_altitude = 120.0\n",
+        &["--depths", "20,20"],
+    );
+    bad(&refs(&a), "reference_altitude = 120 m");
+    // initial_depth above the surface or below the bottom at X0 (b = 100).
+    let a = with_config(PROFILE, "initial_depth = -1.0\n", &["--depths", "20,20"]);
+    bad(&refs(&a), "initial_depth = -1 m is above the surface");
+    let a = with_config(PROFILE, "initial_depth = 100.0\n", &["--depths", "20,20"]);
+    bad(&refs(&a), "initial_depth = 100 m is at or below the bottom");
+    let a = with_config(PROFILE, "initial_depth = 150.0\n", &["--depths", "20,20"]);
+    bad(&refs(&a), "initial_depth = 150 m is at or below the bottom");
+    // Inside the water but under h_a: a warning, and the plan is made.
+    let a = with_config(PROFILE, "initial_depth = 50.0\n", &["--depths", "20,20"]);
+    warns(&refs(&a), "below min_altitude = 60 m");
+    // The surface itself and the default are fine.
+    let a = with_config(PROFILE, "initial_depth = 0.0\n", &["--depths", "20,20"]);
+    let out = run(&refs(&a));
+    assert_eq!(out.status.code(), Some(0));
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn water_shallower_than_min_altitude_warns() {
+    let shoal = "x_m,bottom_depth_m\n0,100\n100,110\n200,40\n250,30\n300,100\n";
+    let a = with(shoal, WAYPOINTS, &["--depths", "20,20", "--json"]);
+    let out = warns(
+        &refs(&a),
+        "shallower than min_altitude = 60 m between x = 200 and 250 m",
+    );
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["safe"], false);
+}
+
+#[test]
+fn depths_outside_depth_limits() {
+    let a = with(PROFILE, WAYPOINTS, &["--depths", "20,-1"]);
+    bad(
+        &refs(&a),
+        "value 2 (-1 m) is outside depth_limits [0, 6000] m",
+    );
+    let a = with_config(
+        PROFILE,
+        "depth_limits = [10.0, 30.0]\n",
+        &["--depths", "20,35"],
+    );
+    let err = bad(
+        &refs(&a),
+        "value 2 (35 m) is outside depth_limits [10, 30] m",
+    );
+    assert!(err.contains(".toml"), "{err}");
+    let a = with_config(
+        PROFILE,
+        "depth_limits = [10.0, 30.0]\n",
+        &["--depths", "10,30"],
+    );
+    assert_eq!(run(&refs(&a)).status.code(), Some(0));
+}
+
+#[test]
+fn conflicting_and_repeated_options() {
+    for opt in [
+        &["--mode", "track"][..],
+        &["--method", "gd"],
+        &["--horizon", "2"],
+        &["--unconstrained"],
+    ] {
+        let mut a = vec!["--depths", "990,900,700,400,250"];
+        a.extend(opt);
+        bad(&a, &format!("cannot be combined with {}", opt[0]));
+    }
+    bad(
+        &["--mode", "track", "--horizon", "2"],
+        "--horizon applies to --mode horizon only",
+    );
+    bad(
+        &["--horizon=2", "--mode=track"],
+        "--horizon applies to --mode horizon only",
+    );
+    for twice in [
+        &[
+            "--profile",
+            "p.csv",
+            "--profile",
+            "q.csv",
+            "--waypoints",
+            "w.csv",
+        ][..],
+        &["--waypoints", "w.csv", "--waypoints=w.csv"],
+        &["--json", "--json"],
+        &["--mode", "track", "--mode", "track"],
+        &["--config", "a.toml", "--config", "b.toml"],
+    ] {
+        bad(
+            twice,
+            &format!(
+                "{} given more than once",
+                twice[0].split('=').next().unwrap()
+            ),
+        );
+    }
+    bad(
+        &["--waypoints", "w.csv"],
+        "--profile and --waypoints go together",
+    );
+    bad(
+        &["--profile", "p.csv"],
+        "--profile and --waypoints go together",
+    );
+}
+
+#[test]
+fn help_lists_the_whole_interface() {
+    for flag in ["--help", "-h"] {
+        let out = run(&[flag]);
+        assert_eq!(out.status.code(), Some(0));
+        let text = String::from_utf8(out.stdout).unwrap();
+        for item in [
+            "--profile",
+            "--waypoints",
+            "--config",
+            "--depths",
+            "--method",
+            "--mode",
+            "--horizon",
+            "--unconstrained",
+            "--json",
+            "--trajectory",
+            "--plot",
+            "horizon (default)",
+            "bfgs (default",
+            "us_monterey_canyon_1",
+            "speed = 1.5",
+            "sample_time = 0.1",
+            "pitch_limit = 25.0",
+            "elevator_limit = 25.0",
+            "reference_altitude = 80.0",
+            "min_altitude = 60.0",
+            "b(X0) - h_r",
+            "depth_limits = [0.0, 6000.0]",
+            "horizontal_uncertainty = 0.0",
+            "nav_drift = 0.0",
+            "vertical_uncertainty = 0.0",
+            "speed_uncertainty = 0.0",
+            "flight_path_offset = 0.0",
+            "vertical_current = 0.0",
+            "[depth_pid]",
+            "kp = 1.5",
+            "[pitch_pid]",
+            "ki = 0.1",
+            "[plant]",
+            "den = [1.0, 2.681, 0.546, 0.048]",
+            "[optimizer]",
+            "max_iterations = 200",
+            "m/s",
+            "deg",
+        ] {
+            assert!(text.contains(item), "--help lacks {item:?}");
+        }
+    }
+}
+
+#[test]
+fn outputs_name_profile_vehicle_and_altitudes() {
+    let v = json_of(&["--depths", "990,900,700,400,250", "--json"]);
+    assert_eq!(v["profile"], "us_monterey_canyon_1 (bundled)");
+    assert_eq!(v["vehicle"], "C-AUV #4 (default)");
+    assert_eq!(v["reference_altitude"], 80.0);
+    assert_eq!(v["min_altitude_limit"], 60.0);
+    // The existing keys are unchanged: min_altitude is the least flown.
+    assert!(v["min_altitude"].as_f64().unwrap() != 60.0);
+    let a = with_config(
+        PROFILE,
+        "reference_altitude = 50.0\nmin_altitude = 30.0\n",
+        &["--depths", "50,50", "--json"],
+    );
+    let v = json_of(&refs(&a));
+    assert!(
+        v["profile"].as_str().unwrap().ends_with(".csv"),
+        "{}",
+        v["profile"]
+    );
+    assert!(
+        v["vehicle"].as_str().unwrap().ends_with(".toml"),
+        "{}",
+        v["vehicle"]
+    );
+    assert_eq!(v["reference_altitude"], 50.0);
+    assert_eq!(v["min_altitude_limit"], 30.0);
+    let out = run(&["--depths", "990,900,700,400,250"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(
+        text.lines().nth(1).unwrap(),
+        "profile us_monterey_canyon_1 (bundled), vehicle C-AUV #4 (default), h_r 80 m, h_a 60 m"
+    );
+}

@@ -37,9 +37,89 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
-pub const USAGE: &str = "usage: plan [--profile PROFILE.csv --waypoints WAYPOINTS.csv] [--config VEHICLE.toml] \
-[--depths z1,...,zM] [--method bfgs|gd] [--mode horizon|track] [--horizon K] [--unconstrained] \
-[--json] [--trajectory OUT.csv] [--plot OUT.svg]";
+/// `plan --help`: the whole interface of spec/cli.md with every default.
+pub const USAGE: &str = "\
+usage: plan [--profile PROFILE.csv --waypoints WAYPOINTS.csv] [--config VEHICLE.toml]
+            [--depths z1,...,zM] [--method bfgs|gd] [--mode horizon|track] [--horizon K]
+            [--unconstrained] [--json] [--trajectory OUT.csv] [--plot OUT.svg]
+
+Plans the reference depth of each track of a survey line over a bottom profile
+(or, with --depths, evaluates given depths). With no --profile/--waypoints it
+plans the bundled line us_monterey_canyon_1 with the defaults below.
+
+Options (each at most once; --flag VALUE or --flag=VALUE):
+  --profile PROFILE.csv      bottom profile, header x_m,bottom_depth_m: along-track
+                             distance (m, strictly increasing) and bottom depth
+                             (m, positive down). Goes with --waypoints.
+  --waypoints WAYPOINTS.csv  header wp,x_m (more columns allowed, ignored); waypoint 0
+                             starts the line, M = waypoints - 1 tracks; every
+                             waypoint within the profile. Goes with --profile.
+  --config VEHICLE.toml      vehicle and mission settings (keys below); default:
+                             the C-AUV #4 of model.md section 9
+  --depths z1,...,zM         evaluate exactly these reference depths (m, one per
+                             track, within depth_limits); no optimization, method
+                             \"fixed\". Not with --mode, --method, --horizon, --unconstrained.
+  --mode horizon|track       horizon (default): optimize the next K tracks jointly and
+                             commit the first; track: each track alone, as the paper
+  --method bfgs|gd           optimizer: bfgs (default, Armijo backtracking) or gd
+                             (gradient descent, constant rate)
+  --horizon K                tracks optimized jointly in horizon mode, 1 to 8 (default:
+                             all remaining, at most 8). Not with --mode track.
+  --unconstrained            optimize J alone, ignoring min_altitude (safety is still
+                             evaluated and reported)
+  --json                     one JSON object on stdout instead of the table
+  --trajectory OUT.csv       write every simulated sample: x_m,depth_m,bottom_m,
+                             target_m,pitch_deg,elevator_deg,reference_m
+  --plot OUT.svg             draw the flight, the h_r and h_a envelopes, the waypoints
+                             and J against iteration
+  -h, --help                 print this help
+
+VEHICLE.toml (every key optional, default shown; an unknown key is an error):
+  speed = 1.5                  # U0, m/s, > 0
+  sample_time = 0.1            # Ts, s, > 0
+  pitch_limit = 25.0           # theta_max, deg
+  elevator_limit = 25.0        # delta_max, deg
+  reference_altitude = 80.0    # h_r, m; at most the water depth at waypoint 0
+  min_altitude = 60.0          # h_a, m, 0 < h_a <= h_r
+  initial_depth = ...          # d0 at waypoint 0, m; default b(X0) - h_r;
+                               # between the surface (0) and the bottom
+  depth_limits = [0.0, 6000.0] # allowed reference depths, m: exactly [min, max]
+  # Declared uncertainty (model.md section 12), each finite and >= 0, default 0
+  # (0 = nominal model and map). Parsed and validated; not yet used by the
+  # planner, which then warns that safety is certified nominally only.
+  horizontal_uncertainty = 0.0 # e_h, m: map/navigation offset at waypoint 0
+  nav_drift = 0.0              # r, m per m travelled (0.002 = 2 m per km)
+  vertical_uncertainty = 0.0   # e_v, m: vertical map error
+  speed_uncertainty = 0.0      # eps_U, fraction of speed, < 1
+  flight_path_offset = 0.0     # alpha_max, deg, < pitch_limit
+  vertical_current = 0.0       # w_max, m/s
+  [depth_pid]                  # depth -> pitch: deg/m, deg/(m s), deg s/m
+  kp = 1.5
+  ki = 0.0
+  kd = 2.0
+  [pitch_pid]                  # pitch -> elevator: -, 1/s, s
+  kp = 2.0
+  ki = 0.1
+  kd = 3.0
+  [plant]                      # coefficients highest power first
+  kind = \"pitch\"               # \"pitch\": theta(s)/delta(s); \"rate\": q(s)/delta(s)
+  num = [-0.173]               # kind = \"rate\" default: [-0.173, 0.0]
+  den = [1.0, 2.681, 0.546, 0.048]
+  [optimizer]
+  max_iterations = 200         # per track, >= 1
+  gd_rate = 1e-4               # gradient-descent learning rate, > 0
+  scan_points = 9              # depths of the starting-point scan
+
+Output: a table (with a header naming the profile, the vehicle, h_r and h_a)
+or, with --json, one object: method, mode, tracks[] (track, x_start, x_end,
+depth, J, rms, min_altitude, safe, iterations, evaluations, status, J_history),
+total_J, min_altitude (least flown), safe, profile, reference_altitude,
+min_altitude_limit (h_a), vehicle.
+
+Exit status: 0 on success (also for a plan that cannot be made safe: it is
+reported safe = false); 2 for bad input, with one line on stderr naming the
+problem and where. Warnings (one line each, starting 'warning:') go to stderr
+and the tool continues.";
 
 impl Args {
     /// Parses the arguments as the operating system passes them: one that
@@ -75,11 +155,20 @@ impl Args {
             trajectory: None,
             plot: None,
         };
+        // Every option at most once: a second `--profile` would silently
+        // replace the first.
+        let mut seen: Vec<String> = Vec::new();
         while let Some(arg) = it.next() {
             let (flag, inline) = match arg.split_once('=') {
                 Some((f, v)) if f.starts_with("--") => (f.to_string(), Some(v.to_string())),
                 _ => (arg.clone(), None),
             };
+            if flag.starts_with('-') && flag != "-h" && flag != "--help" {
+                if seen.contains(&flag) {
+                    return Err(Fail::usage(format!("{flag} given more than once")));
+                }
+                seen.push(flag.clone());
+            }
             let mut value = |name: &str| -> Result<String, Fail> {
                 match inline.clone().or_else(|| it.next()) {
                     Some(v) => Ok(v),
@@ -135,6 +224,23 @@ impl Args {
                 "-h" | "--help" => return Err(Fail::Help),
                 other => return Err(Fail::usage(format!("unknown argument '{other}'"))),
             }
+        }
+        let given = |f: &str| seen.iter().any(|s| s == f);
+        if a.depths.is_some() {
+            // `--depths` evaluates fixed depths: no optimizer runs, so these
+            // options would be silently ignored.
+            for f in ["--mode", "--method", "--horizon", "--unconstrained"] {
+                if given(f) {
+                    return Err(Fail::usage(format!(
+                        "--depths evaluates the given depths without optimizing: it cannot be combined with {f}"
+                    )));
+                }
+            }
+        }
+        if a.mode == Mode::Track && a.horizon.is_some() {
+            return Err(Fail::usage(
+                "--horizon applies to --mode horizon only, not to --mode track".into(),
+            ));
         }
         if a.profile.is_some() != a.waypoints.is_some() {
             return Err(Fail::usage(

@@ -28,13 +28,15 @@ pub fn read(path: &Path) -> Result<String, Fail> {
 }
 
 /// Parses a CSV whose header names at least `columns` (in any order, more
-/// allowed); returns those columns, row by row.
-fn csv(text: &str, name: &str, columns: &[&str]) -> Result<Vec<Vec<f32>>, Fail> {
+/// allowed); returns those columns, row by row, each with its 1-based line
+/// number in the file as an editor shows it (blank lines are skipped but
+/// counted).
+fn csv(text: &str, name: &str, columns: &[&str]) -> Result<Vec<(usize, Vec<f32>)>, Fail> {
     let mut lines = text
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty());
-    let (_, header) = lines
+    let (header_index, header) = lines
         .next()
         .ok_or_else(|| Fail::input(format!("{name}: empty file")))?;
     let header: Vec<&str> = header
@@ -47,7 +49,8 @@ fn csv(text: &str, name: &str, columns: &[&str]) -> Result<Vec<Vec<f32>>, Fail> 
         .map(|c| {
             header.iter().position(|h| h == c).ok_or_else(|| {
                 Fail::input(format!(
-                    "{name}:1: header must name column '{c}' (expected {})",
+                    "{name}:{}: header must name column '{c}' (expected {})",
+                    header_index + 1,
                     columns.join(",")
                 ))
             })
@@ -77,7 +80,7 @@ fn csv(text: &str, name: &str, columns: &[&str]) -> Result<Vec<Vec<f32>>, Fail> 
             }
             row.push(v);
         }
-        rows.push(row);
+        rows.push((lineno, row));
     }
     Ok(rows)
 }
@@ -92,9 +95,10 @@ pub fn profile(text: &str, name: &str) -> Result<(Vec<f32>, Vec<f32>), Fail> {
             rows.len()
         )));
     }
-    let x: Vec<f32> = rows.iter().map(|r| r[0]).collect();
-    let b: Vec<f32> = rows.iter().map(|r| r[1]).collect();
-    increasing(&x, name, "x_m")?;
+    increasing(&rows, name, "x_m")?;
+    let x: Vec<f32> = rows.iter().map(|r| r.1[0]).collect();
+    let b: Vec<f32> = rows.iter().map(|r| r.1[1]).collect();
+    elevations(&b, name)?;
     Ok((x, b))
 }
 
@@ -107,23 +111,38 @@ pub fn waypoints(text: &str, name: &str) -> Result<Vec<f32>, Fail> {
             rows.len()
         )));
     }
-    let x: Vec<f32> = rows.iter().map(|r| r[0]).collect();
-    increasing(&x, name, "x_m")?;
-    Ok(x)
+    increasing(&rows, name, "x_m")?;
+    Ok(rows.iter().map(|r| r.1[0]).collect())
 }
 
-fn increasing(x: &[f32], name: &str, col: &str) -> Result<(), Fail> {
-    for (i, w) in x.windows(2).enumerate() {
-        if w[1] <= w[0] {
-            // Data row i + 1 is on line i + 3 (header on line 1), when the
-            // file has no blank lines.
+/// Checks that the first column strictly increases, naming the file line.
+fn increasing(rows: &[(usize, Vec<f32>)], name: &str, col: &str) -> Result<(), Fail> {
+    for w in rows.windows(2) {
+        let ((_, a), (line, b)) = (&w[0], &w[1]);
+        if b[0] <= a[0] {
             return Err(Fail::input(format!(
-                "{name}:{}: {col} {} does not increase after {}",
-                i + 3,
-                w[1],
-                w[0]
+                "{name}:{line}: {col} {} does not increase after {}",
+                b[0], a[0]
             )));
         }
+    }
+    Ok(())
+}
+
+/// A profile whose depths are mostly negative is elevations (positive up,
+/// as GEBCO and other grids store them), not depths: an error rather than
+/// a plan over a line that lies above the sea. A few negative samples (a
+/// line that touches land) are left to the shallow-water warning of
+/// `main.rs`.
+fn elevations(b: &[f32], name: &str) -> Result<(), Fail> {
+    let negative = b.iter().filter(|&&v| v < 0.0).count();
+    if negative * 2 > b.len() {
+        return Err(Fail::input(format!(
+            "{name}: {negative} of {} bottom_depth_m values are negative: these look like \
+             elevations (positive up, as GEBCO stores them); bottom_depth_m is depth, positive \
+             down: negate the column",
+            b.len()
+        )));
     }
     Ok(())
 }
@@ -138,7 +157,15 @@ struct FileConfig {
     reference_altitude: Option<f64>,
     min_altitude: Option<f64>,
     initial_depth: Option<f64>,
-    depth_limits: Option<[f64; 2]>,
+    // A list of any length, so that a wrong length is an error that names
+    // the key (a fixed array would also be fine, but this reads better).
+    depth_limits: Option<Vec<f64>>,
+    horizontal_uncertainty: Option<f64>,
+    nav_drift: Option<f64>,
+    vertical_uncertainty: Option<f64>,
+    speed_uncertainty: Option<f64>,
+    flight_path_offset: Option<f64>,
+    vertical_current: Option<f64>,
     depth_pid: Option<FilePid>,
     pitch_pid: Option<FilePid>,
     plant: Option<FilePlant>,
@@ -191,6 +218,33 @@ impl OptimizerSettings {
     }
 }
 
+/// The declared uncertainty of model.md section 12 (every bound defaults
+/// to 0: the nominal model and map). The library does not take it yet:
+/// the tool parses and validates it here so that it can be wired into the
+/// planner's certification later.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Uncertainty {
+    /// `e_h`, m: along-track offset between map and navigated position at `X_0`.
+    pub horizontal: f32,
+    /// `r`, m per m travelled: growth of that offset from `X_0`.
+    pub drift: f32,
+    /// `e_v`, m: vertical error of the map.
+    pub vertical: f32,
+    /// `ε_U`, fraction of `U0`: relative error of the true speed (< 1).
+    pub speed: f32,
+    /// `α_max`, deg: bound on the angle between pitch and flight path (< `θmax`).
+    pub flight_path_offset_deg: f32,
+    /// `w_max`, m/s: bound on a constant vertical water velocity.
+    pub vertical_current: f32,
+}
+
+impl Uncertainty {
+    /// Whether any bound is declared (non-zero).
+    pub fn is_declared(&self) -> bool {
+        *self != Self::default()
+    }
+}
+
 /// Everything the config file sets, resolved against the defaults.
 pub struct Config {
     pub vehicle: VehicleConfig,
@@ -199,6 +253,8 @@ pub struct Config {
     /// `None`: the default `b(X_0) - h_r`.
     pub initial_depth: Option<f32>,
     pub optimizer: OptimizerSettings,
+    /// Declared uncertainty (model.md section 12).
+    pub uncertainty: Uncertainty,
 }
 
 /// A finite f32 from an optional f64 key, or the default.
@@ -226,9 +282,16 @@ pub fn config(text: Option<(&str, &str)>) -> Result<Config, Fail> {
         None => (FileConfig::default(), ""),
         Some((text, name)) => {
             let parsed: FileConfig = toml::from_str(text).map_err(|e| {
-                let line = e
-                    .span()
-                    .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+                // 1-based line of the span's start: the newlines before it,
+                // plus one (`lines().count()` of the text before it missed
+                // the line when the span starts a line, as a key does).
+                let line = e.span().map(|s| {
+                    text.get(..s.start.min(text.len()))
+                        .unwrap_or(text)
+                        .matches('\n')
+                        .count()
+                        + 1
+                });
                 match line {
                     Some(l) => Fail::input(format!("{name}:{l}: {}", e.message().trim())),
                     None => Fail::input(format!("{name}: {}", e.message().trim())),
@@ -270,14 +333,33 @@ pub fn config(text: Option<(&str, &str)>) -> Result<Config, Fail> {
             )?,
         },
     };
+    let uncertainty = uncertainty(
+        [
+            file.horizontal_uncertainty,
+            file.nav_drift,
+            file.vertical_uncertainty,
+            file.speed_uncertainty,
+            file.flight_path_offset,
+            file.vertical_current,
+        ],
+        vehicle.autopilot.pitch_limit,
+        name,
+    )?;
     let plant = plant(file.plant.unwrap_or_default(), name)?;
     let m = Mission::default();
-    let limits = match file.depth_limits {
+    let limits = match file.depth_limits.as_deref() {
         None => m.depth_limits(),
-        Some([lo, hi]) => [
+        Some(&[lo, hi]) => [
             num(Some(lo), 0.0, "depth_limits", name)?,
             num(Some(hi), 0.0, "depth_limits", name)?,
         ],
+        Some(other) => {
+            return Err(Fail::input(format!(
+                "{}depth_limits must be a pair [min, max] of depths in m, got {} values",
+                prefix(name),
+                other.len()
+            )));
+        }
     };
     let mission = Mission::new(
         num(
@@ -303,6 +385,7 @@ pub fn config(text: Option<(&str, &str)>) -> Result<Config, Fail> {
         )));
     }
     Ok(Config {
+        uncertainty,
         vehicle,
         plant,
         mission,
@@ -316,6 +399,47 @@ pub fn config(text: Option<(&str, &str)>) -> Result<Config, Fail> {
             scan_points: opt.scan_points,
         },
     })
+}
+
+/// The six uncertainty keys: each finite and `>= 0`, `speed_uncertainty
+/// < 1` (the vehicle moves forward in every world) and `flight_path_offset
+/// < pitch_limit`.
+/// `keys` in the order of [`Uncertainty`]'s fields.
+fn uncertainty(keys: [Option<f64>; 6], pitch_limit: f32, name: &str) -> Result<Uncertainty, Fail> {
+    let [eh, r, ev, eu, alpha, w] = keys;
+    let bound = |v: Option<f64>, key: &str| -> Result<f32, Fail> {
+        let f = num(v, 0.0, key, name)?;
+        if f < 0.0 {
+            return Err(Fail::input(format!(
+                "{}{key} = {f} must be >= 0 (a bound on a magnitude)",
+                prefix(name)
+            )));
+        }
+        Ok(f)
+    };
+    let u = Uncertainty {
+        horizontal: bound(eh, "horizontal_uncertainty")?,
+        drift: bound(r, "nav_drift")?,
+        vertical: bound(ev, "vertical_uncertainty")?,
+        speed: bound(eu, "speed_uncertainty")?,
+        flight_path_offset_deg: bound(alpha, "flight_path_offset")?,
+        vertical_current: bound(w, "vertical_current")?,
+    };
+    if u.speed >= 1.0 {
+        return Err(Fail::input(format!(
+            "{}speed_uncertainty = {} must be below 1 (a fraction of speed)",
+            prefix(name),
+            u.speed
+        )));
+    }
+    if u.flight_path_offset_deg >= pitch_limit {
+        return Err(Fail::input(format!(
+            "{}flight_path_offset = {} deg must be below pitch_limit = {pitch_limit} deg",
+            prefix(name),
+            u.flight_path_offset_deg
+        )));
+    }
+    Ok(u)
 }
 
 /// `"NAME: "` or nothing for the built-in defaults.

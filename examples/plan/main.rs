@@ -40,6 +40,15 @@ fn main() -> ExitCode {
 
 fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let args = args?;
+    // What the report calls the profile and the vehicle.
+    let profile_label = args.profile.as_ref().map_or_else(
+        || "us_monterey_canyon_1 (bundled)".to_string(),
+        |p| p.display().to_string(),
+    );
+    let vehicle_label = args.config.as_ref().map_or_else(
+        || "C-AUV #4 (default)".to_string(),
+        |p| p.display().to_string(),
+    );
     let (profile_text, profile_name, wp_text, wp_name) = match (&args.profile, &args.waypoints) {
         (Some(p), Some(w)) => (
             input::read(p)?,
@@ -79,11 +88,30 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let initial_depth = cfg
         .initial_depth
         .unwrap_or_else(|| scenario.default_initial_depth());
+    for w in sanity(&cfg, cfg_name, &profile, &profile_name, &wx)? {
+        eprintln!("warning: {w}");
+    }
 
     let tracks = waypoints.tracks();
     let report_base = match &args.depths {
         Some(text) => {
             let depths = args::parse_depths(text, tracks)?;
+            let [lo, hi] = cfg.mission.depth_limits();
+            if let Some((i, z)) = depths
+                .iter()
+                .enumerate()
+                .find(|&(_, &z)| !(lo..=hi).contains(&z))
+            {
+                return Err(Fail::input(format!(
+                    "--depths: value {} ({z} m) is outside depth_limits [{lo}, {hi}] m{}",
+                    i + 1,
+                    if cfg_name.is_empty() {
+                        " (the default)".to_string()
+                    } else {
+                        format!(" of {cfg_name}")
+                    }
+                )));
+            }
             Plan {
                 method: "fixed",
                 mode: "fixed",
@@ -119,6 +147,10 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
 
     let h_a = cfg.mission.min_altitude();
     let report = Report {
+        profile: profile_label,
+        vehicle: vehicle_label,
+        reference_altitude: h_r,
+        min_altitude_limit: h_a,
         method: report_base.method,
         mode: report_base.mode,
         tracks: scores
@@ -171,6 +203,116 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         print!("{}", report.table());
     }
     Ok(())
+}
+
+/// Inputs that are valid numbers but cannot describe a real flight
+/// (spec/cli.md, Errors). Errors, since no plan could mean anything:
+/// - `reference_altitude` larger than the water depth at waypoint 0 (the
+///   default start depth `b(X_0) - h_r` is above the surface, and the
+///   target depth there is too);
+/// - `initial_depth` above the surface (< 0) or at or below the bottom at
+///   waypoint 0.
+///
+/// Warnings (the plan is still made, and reported unsafe where it is):
+/// - an `initial_depth` that starts below `h_a` above the bottom;
+/// - water shallower than `min_altitude` somewhere on the line (no depth
+///   is safe there; a line that touches land lands here too);
+/// - a declared uncertainty: the library does not use it yet, so `safe` is
+///   the nominal certification only.
+///
+/// Elevation-like (mostly negative) profiles and a `depth_limits` that is
+/// not a pair are rejected when the inputs are parsed (`input.rs`), and
+/// `--depths` outside `depth_limits` in `run`.
+fn sanity(
+    cfg: &input::Config,
+    cfg_name: &str,
+    profile: &Profile<SAMPLES>,
+    profile_name: &str,
+    wx: &[f32],
+) -> Result<Vec<String>, Fail> {
+    let cfg_where = if cfg_name.is_empty() {
+        "the default".to_string()
+    } else {
+        format!("{cfg_name}:")
+    };
+    let h_r = cfg.mission.reference_altitude();
+    let h_a = cfg.mission.min_altitude();
+    let (x0, xm) = (wx[0], wx[wx.len() - 1]);
+    let b0 = profile
+        .depth_at(x0)
+        .map_err(|e| Fail::input(format!("{profile_name}: waypoint 0 (x = {x0} m): {e}")))?;
+    let mut warnings = Vec::new();
+    if h_r > b0 {
+        return Err(Fail::input(format!(
+            "{cfg_where} reference_altitude = {h_r} m is larger than the water depth {b0} m at \
+             waypoint 0 (x = {x0} m) of {profile_name}: the start depth b(X0) - h_r = {} m would \
+             be above the surface; set a smaller reference_altitude (and min_altitude)",
+            b0 - h_r
+        )));
+    }
+    if let Some(d) = cfg.initial_depth {
+        if d < 0.0 {
+            return Err(Fail::input(format!(
+                "{cfg_where} initial_depth = {d} m is above the surface (depths are positive down)"
+            )));
+        }
+        if d >= b0 {
+            return Err(Fail::input(format!(
+                "{cfg_where} initial_depth = {d} m is at or below the bottom ({b0} m) at waypoint 0 \
+                 (x = {x0} m) of {profile_name}"
+            )));
+        }
+        if b0 - d < h_a {
+            warnings.push(format!(
+                "{cfg_where} initial_depth = {d} m starts {} m above the bottom at waypoint 0, \
+                 below min_altitude = {h_a} m",
+                b0 - d
+            ));
+        }
+    }
+    // The bottom over the line: the samples inside [X_0, X_M] and the ends.
+    let ends = [(x0, b0), (xm, profile.depth_at(xm).unwrap_or(b0))];
+    let shallow: Vec<(f32, f32)> = profile
+        .positions()
+        .iter()
+        .zip(profile.depths())
+        .map(|(&x, &b)| (x, b))
+        .filter(|&(x, _)| x > x0 && x < xm)
+        .chain(ends)
+        .filter(|&(_, b)| b < h_a)
+        .collect();
+    if let Some(&(xl, bl)) = shallow.iter().min_by(|a, b| a.1.total_cmp(&b.1)) {
+        let from = shallow.iter().map(|p| p.0).fold(f32::INFINITY, f32::min);
+        let to = shallow
+            .iter()
+            .map(|p| p.0)
+            .fold(f32::NEG_INFINITY, f32::max);
+        let span = if from < to {
+            format!("between x = {from} and {to} m")
+        } else {
+            format!("at x = {from} m")
+        };
+        warnings.push(format!(
+            "{profile_name}: the water is shallower than min_altitude = {h_a} m {span} (least \
+             depth {bl} m at x = {xl} m): no depth is safe there"
+        ));
+    }
+    let u = &cfg.uncertainty;
+    if u.is_declared() {
+        warnings.push(format!(
+            "{cfg_where} declared uncertainty (horizontal_uncertainty {} m, nav_drift {}, \
+             vertical_uncertainty {} m, speed_uncertainty {}, flight_path_offset {} deg, \
+             vertical_current {} m/s) is parsed but not yet used by the planner: 'safe' is \
+             certified against the nominal model and map only",
+            u.horizontal,
+            u.drift,
+            u.vertical,
+            u.speed,
+            u.flight_path_offset_deg,
+            u.vertical_current
+        ));
+    }
+    Ok(warnings)
 }
 
 /// Plans the whole line track by track, each from the state in which the

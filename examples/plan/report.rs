@@ -26,6 +26,14 @@ pub struct TrackReport {
 
 /// The whole report.
 pub struct Report {
+    /// The profile: its path as given, or `us_monterey_canyon_1 (bundled)`.
+    pub profile: String,
+    /// The vehicle: the config's path as given, or `C-AUV #4 (default)`.
+    pub vehicle: String,
+    /// `h_r`, m.
+    pub reference_altitude: f32,
+    /// `h_a`, m (the limit; `min_altitude` is the least altitude flown).
+    pub min_altitude_limit: f32,
     pub method: &'static str,
     pub mode: &'static str,
     pub tracks: Vec<TrackReport>,
@@ -75,15 +83,23 @@ impl Report {
             "total_J": num(self.total_j()),
             "min_altitude": num(self.min_altitude()),
             "safe": self.safe(),
+            "profile": self.profile,
+            "reference_altitude": num(self.reference_altitude),
+            "min_altitude_limit": num(self.min_altitude_limit),
+            "vehicle": self.vehicle,
         })
     }
 
     /// The human-readable table.
     pub fn table(&self) -> String {
         let mut s = format!(
-            "method {}, mode {}\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>5} {:>5} {:>5}  {}\n",
+            "method {}, mode {}\nprofile {}, vehicle {}, h_r {} m, h_a {} m\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>5} {:>5} {:>5}  {}\n",
             self.method,
             self.mode,
+            self.profile,
+            self.vehicle,
+            self.reference_altitude,
+            self.min_altitude_limit,
             "track",
             "x_start",
             "x_end",
