@@ -15,7 +15,6 @@ use auvnav::{
     AutopilotConfig, Mission, PidGains, Profile, Scenario, TfKind, TransferFunction, Vehicle,
     VehicleConfig, VehicleState, Waypoints,
 };
-use nalgebra::SVector;
 
 /// Profile capacity.
 pub const SAMPLES: usize = 64;
@@ -447,9 +446,8 @@ impl StartIn {
                 x0,
             ),
             Self::Full(v) => {
-                let eta = SVector::<f32, N>::from_fn(|i, _| {
-                    v.get(i).map_or(0.0, |e| e.get(0.0, -5.0, 5.0))
-                });
+                let eta: [f32; N] =
+                    core::array::from_fn(|i| v.get(i).map_or(0.0, |e| e.get(0.0, -5.0, 5.0)));
                 let depth = d0 + v[4].get(0.0, -len, len);
                 let x = x0 + v[6].get(0.0, -0.05 * track, 1.05 * track);
                 VehicleState::new(

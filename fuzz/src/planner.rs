@@ -30,8 +30,7 @@ use auvnav::{
 
 use crate::known;
 use crate::line::{
-    Line, LineIn, MissionIn, SAMPLES, StartIn, Val, VehicleIn, WAYPOINTS, c_auv4, state_is_finite,
-    state_is_physical,
+    Line, LineIn, MissionIn, StartIn, Val, VehicleIn, c_auv4, state_is_finite, state_is_physical,
 };
 
 /// Most optimizer iterations per call: the cap is part of the contract
@@ -253,7 +252,7 @@ fn plan_line<const N: usize, const K: usize>(
         }
         match result {
             Ok(plan) => {
-                check(sc, &cfg, &state, track, &plan, physical);
+                check(sc, &cfg, &state, track, (&plan, &planner), physical);
                 state = plan.next_state;
                 last = Some(plan.status);
             }
@@ -293,16 +292,20 @@ pub fn check<const N: usize, const K: usize>(
     cfg: &PlannerConfig,
     state: &VehicleState<N>,
     track: usize,
-    plan: &Plan<N, K>,
+    (plan, planner): (&Plan<N>, &Planner<K>),
     physical: bool,
 ) {
     if known::applies(known::ABSURD_OVERFLOW, physical) {
-        check_finite(track, plan);
+        check_finite(track, plan, planner);
     }
-    check_contract(sc, cfg, state, track, plan);
+    check_contract(sc, cfg, state, track, (plan, planner));
 }
 
-fn check_finite<const N: usize, const K: usize>(track: usize, plan: &Plan<N, K>) {
+fn check_finite<const N: usize, const K: usize>(
+    track: usize,
+    plan: &Plan<N>,
+    planner: &Planner<K>,
+) {
     let finite = [
         plan.depth,
         plan.j,
@@ -316,7 +319,7 @@ fn check_finite<const N: usize, const K: usize>(track: usize, plan: &Plan<N, K>)
         "non-finite plan on track {track}: {plan:?}"
     );
     assert!(
-        plan.history.iter().all(|v| v.is_finite()),
+        planner.history().iter().all(|v| v.is_finite()),
         "non-finite history: {plan:?}"
     );
     assert!(
@@ -334,7 +337,7 @@ fn check_contract<const N: usize, const K: usize>(
     cfg: &PlannerConfig,
     state: &VehicleState<N>,
     track: usize,
-    plan: &Plan<N, K>,
+    (plan, planner): (&Plan<N>, &Planner<K>),
 ) {
     let tracks_left = sc.waypoints().tracks() - track;
     let h = plan.horizon_len;
@@ -358,8 +361,9 @@ fn check_contract<const N: usize, const K: usize>(
         "depth {} outside the limits [{lo}, {hi}]",
         plan.depth
     );
-    assert_eq!(plan.horizon[0].to_bits(), plan.depth.to_bits());
-    for &z in &plan.horizon[..h] {
+    assert_eq!(planner.horizon().len(), h);
+    assert_eq!(planner.horizon()[0].to_bits(), plan.depth.to_bits());
+    for &z in planner.horizon() {
         assert!(
             z.is_finite() && z >= lo && z <= hi,
             "horizon depth {z} outside the limits [{lo}, {hi}]: {plan:?}"
@@ -396,7 +400,7 @@ fn check_contract<const N: usize, const K: usize>(
         plan.iterations,
         cfg.bfgs.max_iterations
     );
-    assert!(plan.history.len() <= HISTORY);
+    assert!(planner.history().len() <= HISTORY);
     assert!(plan.evaluations >= 1, "a plan without a simulation");
 
     // The committed depth, flown on its own.

@@ -16,8 +16,8 @@ use auvnav::{Scenario, SimError, TrackScore, VehicleState};
 
 use crate::known;
 use crate::line::{
-    Line, LineIn, MissionIn, PHYSICAL_LENGTH, SAMPLES, StartIn, Val, VehicleIn, WAYPOINTS, c_auv4,
-    state_is_finite, state_is_physical, within,
+    Line, LineIn, MissionIn, PHYSICAL_LENGTH, StartIn, Val, VehicleIn, c_auv4, state_is_finite,
+    state_is_physical, within,
 };
 
 /// One fuzzer input.
