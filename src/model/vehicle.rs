@@ -12,6 +12,8 @@ const GROWTH_WINDOW: u32 = 1024;
 /// A disturbance growing more than this over the window means instability
 /// (a dominant eigenvalue above about 1 + 1e-4 per step).
 const UNSTABLE_GROWTH: f32 = 1.1;
+/// Size of the stability check's disturbance (m, deg, …).
+const SCALE: f32 = 1e-3;
 
 /// Everything about the vehicle that the user configures, with units.
 /// `Default` gives the paper's vehicle (model contract §9).
@@ -97,28 +99,30 @@ impl<const N: usize> Vehicle<N> {
     /// mode (an unused integrator, a loop without depth feedback) gives 1.
     fn disturbance_growth(&self) -> f32 {
         let ap = self.autopilot.config();
-        let (gd, ts) = (ap.depth_pid, self.sample_time());
-        let sign = self.autopilot.loop_sign();
-        let gp = ap.pitch_pid;
+        let (gd, gp, ts) = (ap.depth_pid, ap.pitch_pid, self.sample_time());
         let step = self.speed * ts * crate::num::DEG;
         // State: η, d, d_prev, I_d, I_θ; a disturbance in every component.
-        let mut eta = nalgebra::SVector::<f32, N>::repeat(0.1);
-        let (mut d, mut dp, mut id, mut it) = (1.0_f32, 0.5_f32, 0.1_f32, 0.1_f32);
+        // Kept at `SCALE` (1 mm, 1 mdeg): far inside the clamps for any
+        // sane gains, so the cascade acts linearly.
+        let mut eta = nalgebra::SVector::<f32, N>::repeat(0.1 * SCALE);
+        let (mut d, mut dp, mut id, mut it) = (SCALE, 0.5 * SCALE, 0.1 * SCALE, 0.1 * SCALE);
         let mut window = 0.0_f32;
         for k in 0..GROWTH_STEPS {
             let theta = self.plant.pitch_v(&eta);
             let q = self.plant.pitch_rate_v(&eta);
-            let e_d = -d;
-            let v = -(gd.kp * e_d + gd.ki * id - gd.kd * (d - dp) / ts);
-            let e_t = v - theta;
-            let w = sign * (gp.kp * e_t + gp.ki * it - gp.kd * q);
+            // The control law is the autopilot's own cascade (a unit
+            // disturbance keeps it inside its limits, where it is linear).
+            let w = self
+                .autopilot
+                .cascade(&mut id, &mut it, -d, (d - dp) / ts, theta, q)
+                .elevator;
             // An integrator whose gain is zero feeds nothing back: leave it
             // out, or its harmless linear drift would read as growth.
-            if gd.ki != 0.0 {
-                id += ts * e_d;
+            if gd.ki == 0.0 {
+                id = 0.0;
             }
-            if gp.ki != 0.0 {
-                it += ts * e_t;
+            if gp.ki == 0.0 {
+                it = 0.0;
             }
             eta = self.plant.step_v(&eta, w);
             let theta_next = self.plant.pitch_v(&eta);
@@ -130,9 +134,9 @@ impl<const N: usize> Vehicle<N> {
                 return if norm == 0.0 { 0.0 } else { f32::INFINITY };
             }
             if k >= GROWTH_STEPS - GROWTH_WINDOW {
-                window += libm::logf(norm);
+                window += libm::logf(norm / SCALE);
             }
-            let inv = 1.0 / norm;
+            let inv = SCALE / norm;
             eta *= inv;
             d *= inv;
             dp *= inv;

@@ -6,7 +6,7 @@ use crate::optim::root::{self, RootTol};
 use crate::sim::{TrackScore, VehicleState};
 
 use super::PlanError;
-use super::planner::Flights;
+use super::flights::Flights;
 use super::scan::{ScanLog, grid};
 
 /// The boundary search stops when the safe end is within this much of the

@@ -8,7 +8,7 @@ use crate::optim::{Bounds, Outcome};
 use crate::sim::{Scenario, TrackScore, VehicleState};
 
 use super::fallback::{Flown, fallback};
-pub(super) use super::flights::Flights;
+use super::flights::Flights;
 use super::objective::PlanObjective;
 use super::scan::{ScanLog, ScanSpec, scan_start, search_box};
 use super::single::{self, Decision};
@@ -185,8 +185,9 @@ impl<const K: usize> Planner<K> {
             return self.answer_tripped(&mut fl, &s, t, obj.best_safe, &mut scan);
         }
         first?;
-        let iterations = self.penalty_stages(&mut obj, &s, first_step)?;
-        let iterations = self.escape_plateaus(&mut obj, &s, first_step, iterations)?;
+        let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
+        let iterations =
+            self.escape_plateaus(&mut obj, (s.h, &s.bounds), first_step, iterations)?;
         fl.count = fl.count.saturating_add(obj.evaluations);
         let (f, status) = self.verify(&mut fl, &s, obj.last_flight, &mut scan)?;
         self.keep_warm(track, s.h, f.depth, obj.mu);

@@ -6,7 +6,7 @@ use crate::num::DEG;
 use crate::optim::Bounds;
 use crate::sim::{Scenario, TrackScore, VehicleState};
 
-use super::planner::Flights;
+use super::flights::Flights;
 use super::{MAX_SCAN, PlanError};
 
 /// Point `k` of `n >= 2` evenly spaced over `[lo, hi]`.

@@ -11,7 +11,7 @@
 use crate::optim::Outcome;
 
 use super::fallback::{Flown, boundary, fallback};
-use super::planner::Flights;
+use super::flights::Flights;
 use super::scan::ScanLog;
 use super::{PlanError, PlanStatus};
 

@@ -6,7 +6,6 @@ use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
 use crate::sim::SimError;
 
 use super::objective::{PlanObjective, Stop};
-use super::planner::Setup;
 use super::scan::grid;
 use super::{Method, PlanError, Planner};
 
@@ -33,12 +32,12 @@ impl<const K: usize> Planner<K> {
     pub(super) fn penalty_stages<const N: usize>(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
-        s: &Setup<K>,
+        (h, bounds): (usize, &Bounds<K>),
         first_step: f32,
     ) -> Result<u32, PlanError> {
         let cap = self.cfg.bfgs.max_iterations;
         let mut iterations = self.work.iterations;
-        let stages = if s.h == 1 { 1 } else { self.cfg.penalty_stages };
+        let stages = if h == 1 { 1 } else { self.cfg.penalty_stages };
         let max_mu = (1..stages).fold(self.cfg.penalty_weight, |m, _| m * PENALTY_GROWTH);
         while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 && iterations < cap {
             obj.mu *= PENALTY_GROWTH;
@@ -47,7 +46,7 @@ impl<const K: usize> Planner<K> {
             let taken = self.optimize_onto(
                 obj,
                 &from,
-                &s.bounds,
+                bounds,
                 (first_step, left),
                 &[0.0; K],
                 Merge::Continue,
@@ -66,16 +65,16 @@ impl<const K: usize> Planner<K> {
     pub(super) fn escape_plateaus<const N: usize>(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
-        s: &Setup<K>,
+        (h, bounds): (usize, &Bounds<K>),
         first_step: f32,
         mut iterations: u32,
     ) -> Result<u32, PlanError> {
-        if s.h <= 1 {
+        if h <= 1 {
             return Ok(iterations);
         }
         let cap = self.cfg.bfgs.max_iterations;
-        for j in 0..s.h {
-            let Some(z) = self.plateau_jump(obj, &s.bounds, j) else {
+        for j in 0..h {
+            let Some(z) = self.plateau_jump(obj, bounds, j) else {
                 continue;
             };
             // The jump costs one iteration of the cap; none left, no restart.
@@ -86,7 +85,7 @@ impl<const K: usize> Planner<K> {
             let taken = self.optimize_onto(
                 obj,
                 &z,
-                &s.bounds,
+                bounds,
                 (first_step, budget),
                 &[0.0; K],
                 Merge::IfBetter,
