@@ -33,6 +33,7 @@ use crate::model::{
 /// `Copy`: the profile and the waypoints are held as capacity-erased views,
 /// so only the plant order `N` appears in the type.
 #[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Scenario<'a, const N: usize> {
     vehicle: &'a Vehicle<N>,
     profile: ProfileView<'a>,

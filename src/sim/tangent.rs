@@ -163,6 +163,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
 
 /// Value and exact gradient of a run over `K` consecutive tracks.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Evaluation<const N: usize, const K: usize> {
     /// Score of each track.
     pub scores: [TrackScore; K],
