@@ -1,15 +1,19 @@
-//! The mission's envelope: the reference and minimum altitudes and the
-//! allowed reference depths.
+//! The mission's envelope: the reference and minimum altitudes, the
+//! allowed reference depths, and the uncertainty the plan is certified
+//! against.
 
 use super::check::{ConfigError, finite, positive};
+use super::uncertainty::Uncertainty;
 
-/// The mission's altitude envelope and allowed reference depths.
+/// The mission's altitude envelope, allowed reference depths and declared
+/// uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct Mission {
     reference_altitude: f32,
     min_altitude: f32,
     depth_limits: [f32; 2],
+    uncertainty: Uncertainty,
 }
 
 impl Default for Mission {
@@ -19,6 +23,7 @@ impl Default for Mission {
             reference_altitude: 80.0,
             min_altitude: 60.0,
             depth_limits: [0.0, 6000.0],
+            uncertainty: Uncertainty::NONE,
         }
     }
 }
@@ -50,7 +55,20 @@ impl Mission {
             reference_altitude,
             min_altitude,
             depth_limits,
+            uncertainty: Uncertainty::NONE,
         })
+    }
+
+    /// The same mission, certified against `uncertainty` (model contract
+    /// §12; default none).
+    pub fn with_uncertainty(mut self, uncertainty: Uncertainty) -> Self {
+        self.uncertainty = uncertainty;
+        self
+    }
+
+    /// The declared uncertainty.
+    pub fn uncertainty(&self) -> &Uncertainty {
+        &self.uncertainty
     }
 
     /// `h_r`, m: the target depth is the bottom shifted up by `h_r`.

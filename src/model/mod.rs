@@ -11,7 +11,8 @@
 //! | `plant.rs`, `expm.rs` | [`TransferFunction`] → [`Plant`]: realization and exact ZOH in f32 |
 //! | `autopilot.rs` | [`Autopilot`]: the depth → pitch → elevator cascade, the one statement of the control law |
 //! | `vehicle.rs` | [`Vehicle`]: speed, sample time, plant and autopilot validated together, with the stability check |
-//! | `mission.rs` | [`Mission`]: `h_r`, `h_a`, depth limits |
+//! | `mission.rs` | [`Mission`]: `h_r`, `h_a`, depth limits, declared uncertainty |
+//! | `uncertainty.rs` | [`Uncertainty`] and the certification bottom [`lower_envelope`] |
 //! | `check.rs` | [`ConfigError`] and the validators every constructor uses |
 
 mod autopilot;
@@ -21,6 +22,7 @@ mod line;
 mod mission;
 mod plant;
 mod profile;
+mod uncertainty;
 mod vehicle;
 
 pub use autopilot::{Autopilot, AutopilotConfig, AutopilotState, Command, PidGains, PidTerms};
@@ -29,6 +31,7 @@ pub use line::{WaypointError, Waypoints, WaypointsView};
 pub use mission::Mission;
 pub use plant::{Plant, PlantError, TfKind, TransferFunction};
 pub use profile::{Profile, ProfileError, ProfileView};
+pub use uncertainty::{Uncertainty, lower_envelope};
 pub use vehicle::{MIN_STEP_LENGTH, Vehicle, VehicleConfig};
 
 pub(crate) use profile::{Cursor, Point};

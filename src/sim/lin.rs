@@ -9,9 +9,11 @@ pub(crate) struct StepLin {
     /// Index of the active track among the simulated ones.
     pub slot: usize,
     pub command: Command,
-    /// `sin θ̄`, `cos θ̄`.
+    /// `sin`, `cos` of the flight path `θ̄ − α`.
     pub sin: f32,
     pub cos: f32,
+    /// `U Ts`, m.
+    pub step: f32,
 }
 
 /// Where one end of a scored piece lies.

@@ -10,6 +10,7 @@
 //! | `score.rs` | [`TrackScore`] and the one scoring kernel |
 //! | `lin.rs` | what a step and a scored piece linearize to |
 //! | `tangent.rs` | tangent states: [`Evaluation`], `∂J/∂z` by forward sensitivity |
+//! | `world.rs` | [`World`]: true speed, flight-path offset, vertical current |
 //! | `error.rs` | [`SimError`] |
 
 mod error;
@@ -18,11 +19,15 @@ mod run;
 mod score;
 mod state;
 mod tangent;
+mod world;
 
 pub use error::SimError;
 pub use score::TrackScore;
 pub use state::{Sample, VehicleState};
 pub use tangent::Evaluation;
+pub use world::{MAX_WORLDS, World};
+
+use world::Kinematics;
 
 use crate::model::{
     Mission, Profile, ProfileView, Vehicle, WaypointError, Waypoints, WaypointsView,
@@ -41,6 +46,8 @@ pub struct Scenario<'a, const N: usize> {
     mission: Mission,
     /// Altitude the violation measure is taken against, m (default `h_a`).
     penalty_altitude: f32,
+    /// The world's kinematics (nominal unless [`Scenario::in_world`]).
+    kin: Kinematics,
 }
 
 impl<'a, const N: usize> Scenario<'a, N> {
@@ -77,13 +84,29 @@ impl<'a, const N: usize> Scenario<'a, N> {
                 .depth_at(x)
                 .map_err(|_| WaypointError::OutsideProfile { index })?;
         }
+        let kin = World::nominal(vehicle).kinematics(vehicle.sample_time());
         Ok(Self {
             vehicle,
             profile,
             waypoints,
             penalty_altitude: mission.min_altitude(),
             mission,
+            kin,
         })
+    }
+
+    /// The same line flown in `world` over `bottom` (e.g. the
+    /// certification bottom of [`crate::model::lower_envelope`]): the
+    /// scores are then the world's, against the true bottom.
+    ///
+    /// # Errors
+    /// [`WaypointError::OutsideProfile`] when a waypoint lies outside
+    /// `bottom`.
+    pub fn in_world(&self, world: &World, bottom: ProfileView<'a>) -> Result<Self, SimError> {
+        let mut sc = Self::from_views(self.vehicle, bottom, self.waypoints, self.mission)?;
+        sc.penalty_altitude = self.penalty_altitude;
+        sc.kin = world.kinematics(self.vehicle.sample_time());
+        Ok(sc)
     }
 
     /// The same scenario with the violation measure

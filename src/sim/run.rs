@@ -209,9 +209,8 @@ impl<const N: usize> Scenario<'_, N> {
             .get(first.saturating_add(1))
             .ok_or(SimError::TrackRange)?;
         let plant = self.vehicle.plant();
-        let step_len = self.vehicle.speed() * plant.sample_time();
         // Even flying at 75° on average the line would be done by then.
-        let max_steps = 4.0 * (x_end - start.x()) / step_len + 100.0;
+        let max_steps = 4.0 * (x_end - start.x()) / self.kin.step + 100.0;
         let st = *start;
         let mut cursor = Cursor::default();
         let cur = self.geo(&mut cursor, st.x, st.depth, x_end)?;
@@ -274,8 +273,7 @@ impl<const N: usize> Scenario<'_, N> {
         // partial sum of `J` (added to the track's compensated sum when the
         // run ends) adds up at most that many terms: relative error below
         // `FAST_RUN` ε/2.
-        let horizon =
-            fl.st.x.value() + FAST_RUN * self.vehicle.speed() * self.vehicle.plant().sample_time();
+        let horizon = fl.st.x.value() + FAST_RUN * self.kin.step;
         let event = min(min(fl.track_end, fl.cursor.end()), horizon);
         let fast_limit = event - (1e-3 + 4.0 * f32::EPSILON * libm::fabsf(event));
         let mut acc = *score;
@@ -426,7 +424,7 @@ impl<const N: usize> Scenario<'_, N> {
         });
         let eta = plant.step_v(&st.eta, command.elevator);
         let pitch_next = plant.pitch_v(&eta);
-        let mean = (*pitch + pitch_next) * (0.5 * DEG);
+        let mean = (*pitch + pitch_next) * (0.5 * DEG) - self.kin.offset;
         // A cruising vehicle's mean pitch is within ±45°: the short
         // polynomials, whose results are finite with `cos > 0`. Beyond (or
         // NaN, from a diverging loop), the checked general case.
@@ -444,10 +442,11 @@ impl<const N: usize> Scenario<'_, N> {
             }
             (sin, cos)
         };
-        // With `r`, `d` and `Δd` finite, `e_d` and so `I_d` are.
-        let step_len = self.vehicle.speed() * ts;
-        let dx = step_len * cos;
-        let dd = -step_len * sin;
+        // With `r`, `d` and `Δd` finite, `e_d` and so `I_d` are. In a world
+        // the path is `θ̄ − α` and the water moves `w Ts` (nominal: 0, 0).
+        let k = &self.kin;
+        let dx = k.step * cos;
+        let dd = -k.step * sin + k.sink;
         st.eta = eta;
         *pitch = pitch_next;
         st.depth_prev = st.depth;
@@ -462,6 +461,7 @@ impl<const N: usize> Scenario<'_, N> {
                 command,
                 sin,
                 cos,
+                step: k.step,
             },
         );
         Ok((dx, dd))

@@ -130,7 +130,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
         self.eta = plant.ad_m() * self.eta + plant.bd_v() * elevator.transpose();
         let pitch_next = plant.pitch_of(&self.eta);
         let mean = (pitch + pitch_next) * (0.5 * DEG);
-        let step = v.speed() * ts;
+        let step = lin.step;
         self.d_prev = self.d;
         self.x_prev = self.x;
         self.d -= mean * (step * lin.cos);

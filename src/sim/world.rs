@@ -1,0 +1,123 @@
+//! Flying in a world that is not the model (model contract §12): the true
+//! speed `U`, a flight-path offset `α` between pitch and flight path, and a
+//! vertical current `w`, constant over a flight. The kinematics become
+//!
+//! ```text
+//! d_{k+1} = d_k − U Ts sin(θ̄ − α) + w Ts,   x_{k+1} = x_k + U Ts cos(θ̄ − α)
+//! ```
+//!
+//! with the autopilot, the plant and the waypoint switching (on the
+//! navigated `x`) unchanged. The nominal world (`U = U0`, `α = w = 0`) is
+//! the contract's §6 exactly, bit for bit.
+
+use heapless::Vec;
+
+use crate::model::{Uncertainty, Vehicle};
+use crate::num::DEG;
+
+/// Most worlds [`World::corners`] returns.
+pub const MAX_WORLDS: usize = 12;
+
+/// One world's vehicle: true speed (m/s), flight-path offset `α` (deg,
+/// positive: the flight path points below the pitch) and vertical current
+/// `w` (m/s, positive down).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct World {
+    /// True speed `U`, m/s.
+    pub speed: f32,
+    /// `α`, deg.
+    pub flight_path_offset: f32,
+    /// `w`, m/s, positive down.
+    pub vertical_current: f32,
+}
+
+impl World {
+    /// The model's own world: `U = U0`, no offset, no current.
+    pub fn nominal<const N: usize>(vehicle: &Vehicle<N>) -> Self {
+        Self {
+            speed: vehicle.speed(),
+            flight_path_offset: 0.0,
+            vertical_current: 0.0,
+        }
+    }
+
+    /// The worlds a certificate flies for `u`: every corner of
+    /// `U ∈ {U0 (1 − ε_U), U0, U0 (1 + ε_U)}`, `α = ±α_max`,
+    /// `w = ±w_max`, without repeats where a bound is zero (one world, the
+    /// nominal one, when nothing is declared). Where the flight responds
+    /// linearly to `α` and `w` (inside the autopilot's limits) the lowest
+    /// flight over these is the lowest over the whole box at each speed;
+    /// the speed is taken at both ends and in the middle. This is the
+    /// certificate's sampled part (the map part is exact, see
+    /// [`crate::model::lower_envelope`]); `tests/certified.rs` samples the
+    /// interior.
+    pub fn corners<const N: usize>(
+        vehicle: &Vehicle<N>,
+        u: &Uncertainty,
+    ) -> Vec<World, MAX_WORLDS> {
+        let u0 = vehicle.speed();
+        let mut out = Vec::new();
+        let speeds = [u0, u0 * (1.0 - u.speed()), u0 * (1.0 + u.speed())];
+        let offsets = [u.flight_path_offset(), -u.flight_path_offset()];
+        let currents = [u.vertical_current(), -u.vertical_current()];
+        for (i, &speed) in speeds.iter().enumerate() {
+            if i > 0 && u.speed() == 0.0 {
+                break;
+            }
+            for (j, &flight_path_offset) in offsets.iter().enumerate() {
+                if j > 0 && u.flight_path_offset() == 0.0 {
+                    break;
+                }
+                for (k, &vertical_current) in currents.iter().enumerate() {
+                    if k > 0 && u.vertical_current() == 0.0 {
+                        break;
+                    }
+                    let _ = out.push(World {
+                        speed,
+                        flight_path_offset,
+                        vertical_current,
+                    });
+                }
+            }
+        }
+        out
+    }
+
+    /// The per-sample kinematics at sample time `ts` (s).
+    pub(crate) fn kinematics(&self, ts: f32) -> Kinematics {
+        Kinematics {
+            step: self.speed * ts,
+            offset: self.flight_path_offset * DEG,
+            sink: self.vertical_current * ts,
+        }
+    }
+}
+
+/// What one step's kinematics need: `U Ts` (m), `α` (rad), `w Ts` (m).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub(crate) struct Kinematics {
+    pub step: f32,
+    pub offset: f32,
+    pub sink: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn corners_without_repeats() {
+        let v = Vehicle::c_auv4().unwrap();
+        assert_eq!(World::corners(&v, &Uncertainty::NONE).len(), 1);
+        assert_eq!(
+            World::corners(&v, &Uncertainty::NONE)[0],
+            World::nominal(&v)
+        );
+        let u = Uncertainty::new(0.0, 0.0, 0.0, 0.1, 0.0, 0.1).unwrap();
+        assert_eq!(World::corners(&v, &u).len(), 6);
+        let u = Uncertainty::new(0.0, 0.0, 0.0, 0.1, 1.0, 0.1).unwrap();
+        assert_eq!(World::corners(&v, &u).len(), MAX_WORLDS);
+    }
+}
