@@ -88,12 +88,14 @@ pub use error::Error;
 pub use model::{
     Autopilot, AutopilotConfig, AutopilotState, Command, ConfigError, MIN_STEP_LENGTH, Mission,
     PidGains, PidTerms, Plant, PlantError, Profile, ProfileError, ProfileView, TfKind,
-    TransferFunction, Vehicle, VehicleConfig, WaypointError, Waypoints, WaypointsView,
+    TransferFunction, Uncertainty, Vehicle, VehicleConfig, WaypointError, Waypoints, WaypointsView,
+    lower_envelope,
 };
 pub use plan::{
-    Method, Mode, Plan, PlanConfigError, PlanError, PlanStatus, Planner, PlannerConfig,
+    Method, Mode, OptimizerStop, Plan, PlanConfigError, PlanError, PlanStatus, Planner,
+    PlannerConfig,
 };
-pub use sim::{Evaluation, Sample, Scenario, SimError, TrackScore, VehicleState};
+pub use sim::{Evaluation, Sample, Scenario, SimError, TrackScore, VehicleState, World};
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

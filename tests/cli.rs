@@ -37,10 +37,16 @@ fn run(args: &[&str]) -> Output {
 }
 
 fn tmp(name: &str, text: &str) -> PathBuf {
+    static COUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!("auvnav-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
+    // Written aside and renamed: tests running in parallel may write the
+    // same file, and a reader must never see it half written.
+    let n = COUNT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let part = dir.join(format!("{name}.{n}.part"));
+    std::fs::write(&part, text).unwrap();
+    std::fs::rename(&part, &p).unwrap();
     p
 }
 
@@ -376,16 +382,19 @@ fn planning_modes_report_the_optimizer() {
             for t in v["tracks"].as_array().unwrap() {
                 let status = t["status"].as_str().unwrap();
                 assert!(
-                    [
-                        "converged",
-                        "max_iterations",
-                        "line_search_failed",
-                        "safe_fallback",
-                        "infeasible"
-                    ]
-                    .contains(&status),
+                    ["optimal", "constrained", "infeasible"].contains(&status),
                     "{status}"
                 );
+                let stop = t["optimizer"].as_str().unwrap();
+                assert!(
+                    ["converged", "max_iterations", "budget", "stalled", "none"].contains(&stop),
+                    "{stop}"
+                );
+                // Safe exactly when not infeasible; the certificate is the
+                // nominal flight when nothing is declared.
+                assert_eq!(t["safe"] == true, status != "infeasible");
+                assert_eq!(t["certified_min_altitude"], t["min_altitude"]);
+                assert_eq!(t.get("continuation").is_some(), mode == "horizon");
                 let it = t["iterations"].as_u64().unwrap();
                 let ev = t["evaluations"].as_u64().unwrap();
                 let hist = t["J_history"].as_array().unwrap();
@@ -418,9 +427,10 @@ fn unconstrained_ignores_the_minimum_altitude() {
     assert!(b1["J"].as_f64().unwrap() < s1["J"].as_f64().unwrap());
     assert!(b1["min_altitude"].as_f64().unwrap() < 60.0);
     assert!(s1["min_altitude"].as_f64().unwrap() >= 60.0);
+    // Unconstrained, nothing is done about safety: a track that is not
+    // safe says so (infeasible), never optimal or constrained.
     for t in bare["tracks"].as_array().unwrap() {
-        assert_ne!(t["status"], "safe_fallback");
-        assert_ne!(t["status"], "infeasible");
+        assert_eq!(t["safe"] == false, t["status"] == "infeasible", "{t}");
     }
 }
 
@@ -491,9 +501,25 @@ fn with_config(profile: &str, toml: &str, extra: &[&str]) -> Vec<String> {
 fn uncertainty_keys_are_parsed_and_validated() {
     let all = "horizontal_uncertainty = 5.0\nnav_drift = 0.002\nvertical_uncertainty = 2.0\n\
                speed_uncertainty = 0.1\nflight_path_offset = 3.0\nvertical_current = 0.05\n";
-    // Accepted; the planner does not use them yet, and says so.
-    let a = with_config(PROFILE, all, &["--depths", "20,20"]);
-    warns(&refs(&a), "not yet used by the planner");
+    // Accepted, and certified against: the worst world is lower than the
+    // nominal flight.
+    let mut a = with_config(PROFILE, all, &["--depths", "20,20"]);
+    a.push("--json".into());
+    let out = run(&refs(&a));
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    for t in v["tracks"].as_array().unwrap() {
+        let (c, m) = (
+            t["certified_min_altitude"].as_f64().unwrap(),
+            t["min_altitude"].as_f64().unwrap(),
+        );
+        assert!(c < m - 1.0, "certified {c} vs nominal {m}");
+    }
     // All zero is the nominal model: no warning.
     let zero = "horizontal_uncertainty = 0.0\nnav_drift = 0\nvertical_uncertainty = 0\n\
                 speed_uncertainty = 0\nflight_path_offset = 0\nvertical_current = 0\n";

@@ -238,13 +238,6 @@ pub struct Uncertainty {
     pub vertical_current: f32,
 }
 
-impl Uncertainty {
-    /// Whether any bound is declared (non-zero).
-    pub fn is_declared(&self) -> bool {
-        *self != Self::default()
-    }
-}
-
 /// Everything the config file sets, resolved against the defaults.
 pub struct Config {
     pub vehicle: VehicleConfig,

@@ -16,12 +16,17 @@ mod report;
 use std::process::ExitCode;
 
 use auvnav::{
-    Method, Mode, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle, Waypoints,
+    Method, Mode, PlanError, Planner, PlannerConfig, Profile, Scenario, TrackScore, Uncertainty,
+    Vehicle, Waypoints, lower_envelope,
 };
 
 use args::Args;
 use fail::Fail;
 use input::{MAX_HORIZON, SAMPLES, WAYPOINTS};
+
+/// Room for the certification bottom: the map's samples and two window
+/// crossings per sample.
+const ENVELOPE: usize = 3 * SAMPLES + 1;
 use report::{Report, TrackReport, TrajRow};
 
 fn main() -> ExitCode {
@@ -78,13 +83,33 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
     let vehicle = Vehicle::new(&cfg.vehicle, cfg.plant)
         .map_err(|e| Fail::input(format!("{}{e}", input::prefix(cfg_name))))?;
-    let scenario = Scenario::new(&vehicle, &profile, &waypoints, cfg.mission).map_err(|e| {
-        Fail::input(format!(
-            "{wp_name}: {e} [{:.1}, {:.1}] m",
-            profile.start(),
-            profile.end()
-        ))
-    })?;
+    let u = &cfg.uncertainty;
+    let uncertainty = Uncertainty::new(
+        u.horizontal,
+        u.drift,
+        u.vertical,
+        u.speed,
+        u.flight_path_offset_deg,
+        u.vertical_current,
+    )
+    .map_err(|e| Fail::input(format!("{}{e}", input::prefix(cfg_name))))?;
+    let mission = cfg.mission.with_uncertainty(uncertainty);
+    // The certification bottom: the map's lower envelope under the map
+    // uncertainty (the map itself when none is declared).
+    let x0 = wx.first().copied().unwrap_or(0.0);
+    let envelope = Box::new(
+        lower_envelope::<ENVELOPE>(profile.view(), &uncertainty, x0)
+            .map_err(|e| Fail::input(format!("{profile_name}: certification bottom: {e}")))?,
+    );
+    let scenario = Scenario::new(&vehicle, &profile, &waypoints, mission)
+        .and_then(|sc| sc.with_certification_bottom(envelope.view()))
+        .map_err(|e| {
+            Fail::input(format!(
+                "{wp_name}: {e} [{:.1}, {:.1}] m",
+                profile.start(),
+                profile.end()
+            ))
+        })?;
     let initial_depth = cfg
         .initial_depth
         .unwrap_or_else(|| scenario.default_initial_depth());
@@ -146,6 +171,9 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         .map_err(|e| Fail::input(format!("simulation failed: {e}")))?;
 
     let h_a = cfg.mission.min_altitude();
+    // Fixed depths are certified here: flown open loop in every declared
+    // world over the certification bottom (the planner certifies its own).
+    let fixed_cert = certify_open_loop(&scenario, &start, &report_base.depths)?;
     let report = Report {
         profile: profile_label,
         vehicle: vehicle_label,
@@ -157,18 +185,26 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
             .iter()
             .zip(&report_base.depths)
             .zip(&report_base.optimizer)
-            .map(|((s, &depth), eff)| TrackReport {
-                x_start: s.x_start(),
-                x_end: s.x_end(),
-                depth,
-                j: s.j(),
-                rms: s.rms(),
-                min_altitude: s.min_altitude(),
-                safe: s.is_safe(h_a),
-                iterations: eff.iterations,
-                evaluations: eff.evaluations,
-                status: eff.status,
-                j_history: eff.j_history.clone(),
+            .zip(&fixed_cert)
+            .map(|(((s, &depth), eff), &fixed)| {
+                let (certified_min_altitude, safe) = eff.certified.unwrap_or(fixed);
+                let safe = safe && !eff.after_crash;
+                TrackReport {
+                    x_start: s.x_start(),
+                    x_end: s.x_end(),
+                    depth,
+                    j: s.j(),
+                    rms: s.rms(),
+                    min_altitude: s.min_altitude(),
+                    certified_min_altitude,
+                    safe,
+                    iterations: eff.iterations,
+                    evaluations: eff.evaluations,
+                    status: eff.status,
+                    optimizer: eff.optimizer,
+                    continuation: eff.continuation.clone(),
+                    j_history: eff.j_history.clone(),
+                }
             })
             .collect(),
     };
@@ -217,8 +253,6 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
 /// - an `initial_depth` that starts below `h_a` above the bottom;
 /// - water shallower than `min_altitude` somewhere on the line (no depth
 ///   is safe there; a line that touches land lands here too);
-/// - a declared uncertainty: the library does not use it yet, so `safe` is
-///   the nominal certification only.
 ///
 /// Elevation-like (mostly negative) profiles and a `depth_limits` that is
 /// not a pair are rejected when the inputs are parsed (`input.rs`), and
@@ -297,22 +331,36 @@ fn sanity(
              depth {bl} m at x = {xl} m): no depth is safe there"
         ));
     }
-    let u = &cfg.uncertainty;
-    if u.is_declared() {
-        warnings.push(format!(
-            "{cfg_where} declared uncertainty (horizontal_uncertainty {} m, nav_drift {}, \
-             vertical_uncertainty {} m, speed_uncertainty {}, flight_path_offset {} deg, \
-             vertical_current {} m/s) is parsed but not yet used by the planner: 'safe' is \
-             certified against the nominal model and map only",
-            u.horizontal,
-            u.drift,
-            u.vertical,
-            u.speed,
-            u.flight_path_offset_deg,
-            u.vertical_current
-        ));
-    }
     Ok(warnings)
+}
+
+/// Each track's least altitude over the declared worlds and whether it is
+/// at least `h_a`, for `depths` flown open loop from `start` (model
+/// contract §12: the corner worlds over the certification bottom).
+fn certify_open_loop(
+    sc: &Scenario<'_, { input::ORDER }>,
+    start: &auvnav::VehicleState<{ input::ORDER }>,
+    depths: &[f32],
+) -> Result<Vec<(f32, bool)>, Fail> {
+    let h_a = sc.mission().min_altitude();
+    let bottom = sc.certification_bottom().unwrap_or(sc.profile());
+    let mut least = vec![f32::INFINITY; depths.len()];
+    for w in auvnav::World::corners(sc.vehicle(), sc.mission().uncertainty()) {
+        let scw = sc
+            .in_world(&w, bottom)
+            .map_err(|e| Fail::input(format!("certification: {e}")))?;
+        let mut scores = vec![TrackScore::default(); depths.len()];
+        match scw.simulate(start, 0, depths, &mut scores, |_| {}) {
+            Ok(_) => {
+                for (l, s) in least.iter_mut().zip(&scores) {
+                    *l = l.min(s.min_altitude());
+                }
+            }
+            // A world in which the flight fails is not certified.
+            Err(_) => least.iter_mut().for_each(|l| *l = f32::NEG_INFINITY),
+        }
+    }
+    Ok(least.into_iter().map(|m| (m, m >= h_a)).collect())
 }
 
 /// Plans the whole line track by track, each from the state in which the
@@ -336,22 +384,43 @@ fn plan_line(
         constrained: !args.unconstrained,
         ..cfg.optimizer.apply(PlannerConfig::default())
     };
-    let mut planner =
-        Planner::<MAX_HORIZON>::new(pc).map_err(|e| Fail::input(format!("config: {e}")))?;
+    let mut planner = Planner::<MAX_HORIZON, { input::ORDER }>::new(pc)
+        .map_err(|e| Fail::input(format!("config: {e}")))?;
     let mut state = scenario.start_state(initial_depth);
     let tracks = scenario.waypoints().tracks();
     let mut depths = Vec::with_capacity(tracks);
     let mut optimizer = Vec::with_capacity(tracks);
     for n in 0..tracks {
-        let p = planner
-            .plan(scenario, &state, n)
-            .map_err(|e| Fail::input(format!("planning track {}: {e}", n + 1)))?;
+        let p = match planner.plan(scenario, &state, n) {
+            Ok(p) => p,
+            // An infeasible line may fly into the rock before the end: the
+            // tracks after it have no start to plan from. They are flown
+            // at the shallowest allowed depth and reported infeasible.
+            Err(PlanError::StartBelowBottom) if n > 0 => {
+                let shallow = scenario.mission().depth_limits()[0];
+                for _ in n..tracks {
+                    depths.push(shallow);
+                    optimizer.push(Effort {
+                        status: "infeasible",
+                        after_crash: true,
+                        ..Effort::fixed()
+                    });
+                }
+                break;
+            }
+            Err(e) => return Err(Fail::input(format!("planning track {}: {e}", n + 1))),
+        };
         depths.push(p.depth);
         optimizer.push(Effort {
             iterations: p.iterations,
             evaluations: p.evaluations,
             status: p.status.as_str(),
+            optimizer: p.optimizer.as_str(),
+            certified: Some((p.certified_min_altitude, p.safe)),
+            continuation: (args.mode == args::Mode::Horizon && !args.unconstrained)
+                .then(|| planner.continuation().to_vec()),
             j_history: planner.history().to_vec(),
+            after_crash: false,
         });
         state = p.next_state;
     }
@@ -377,13 +446,20 @@ struct Plan {
     optimizer: Vec<Effort>,
 }
 
-/// One track's optimizer effort.
+/// One track's optimizer effort and what the planner certified.
 #[derive(Clone)]
 struct Effort {
     iterations: u32,
     evaluations: u32,
     status: &'static str,
+    optimizer: &'static str,
+    /// Certified minimum altitude (m) and safety, as the planner reported
+    /// them (`None`: fixed depths, certified by the tool).
+    certified: Option<(f32, bool)>,
+    continuation: Option<Vec<f32>>,
     j_history: Vec<f32>,
+    /// Past a predicted collision: no state to certify from.
+    after_crash: bool,
 }
 
 impl Effort {
@@ -392,7 +468,11 @@ impl Effort {
             iterations: 0,
             evaluations: 0,
             status: "fixed",
+            optimizer: "none",
+            certified: None,
+            continuation: None,
             j_history: Vec::new(),
+            after_crash: false,
         }
     }
 }

@@ -17,10 +17,16 @@ pub struct TrackReport {
     pub j: f32,
     pub rms: f32,
     pub min_altitude: f32,
+    /// Least altitude over the declared worlds, m.
+    pub certified_min_altitude: f32,
+    /// Certified safe (model contract §11, §12).
     pub safe: bool,
     pub iterations: u32,
     pub evaluations: u32,
     pub status: &'static str,
+    pub optimizer: &'static str,
+    /// Horizon mode: the later tracks' depths this track's safety rests on.
+    pub continuation: Option<Vec<f32>>,
     pub j_history: Vec<f32>,
 }
 
@@ -60,7 +66,7 @@ impl Report {
             .iter()
             .enumerate()
             .map(|(i, t)| {
-                json!({
+                let mut v = json!({
                     "track": i + 1,
                     "x_start": num(t.x_start),
                     "x_end": num(t.x_end),
@@ -72,8 +78,17 @@ impl Report {
                     "iterations": t.iterations,
                     "evaluations": t.evaluations,
                     "status": t.status,
+                    "optimizer": t.optimizer,
+                    "certified_min_altitude": num(t.certified_min_altitude),
                     "J_history": t.j_history.iter().map(|&v| num(v)).collect::<Vec<_>>(),
-                })
+                });
+                if let (Some(c), Some(o)) = (&t.continuation, v.as_object_mut()) {
+                    o.insert(
+                        "continuation".into(),
+                        c.iter().map(|&z| num(z)).collect::<Vec<_>>().into(),
+                    );
+                }
+                v
             })
             .collect();
         json!({

@@ -5,7 +5,7 @@
 
 use crate::sim::VehicleState;
 
-use super::PlanStatus;
+use super::{OptimizerStop, PlanStatus};
 
 /// The planner's answer for one track.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -13,17 +13,25 @@ use super::PlanStatus;
 pub struct Plan<const N: usize> {
     /// Reference depth to command on the track, m.
     pub depth: f32,
-    /// How it was obtained.
+    /// What the plan is: optimal, constrained, or infeasible.
     pub status: PlanStatus,
-    /// Predicted minimum altitude on the track is at least `h_a` plus the
-    /// safety margin (model contract §8).
+    /// Why the optimizer stopped (a diagnostic, apart from the status).
+    pub optimizer: OptimizerStop,
+    /// Certified safe: in every declared world (model contract §12; the
+    /// nominal model when nothing is declared) the minimum altitude is at
+    /// least `h_a` plus the safety margin on this track and, in horizon
+    /// mode, with [`crate::Planner::continuation`] to the end of the line
+    /// (§11).
     pub safe: bool,
     /// Predicted `J` of the track flown at [`Plan::depth`], m³.
     pub j: f32,
     /// Predicted RMS deviation from the target depth, m.
     pub rms: f32,
-    /// Predicted minimum altitude on the track, m.
+    /// Predicted minimum altitude on the track (nominal model and map), m.
     pub min_altitude: f32,
+    /// Least altitude on the track over the declared worlds, m (equal to
+    /// [`Plan::min_altitude`] when nothing is declared).
+    pub certified_min_altitude: f32,
     /// The optimizer's final objective (`Σ J + μ Σ V` over the horizon), m³.
     pub objective: f32,
     /// Optimizer iterations.

@@ -78,6 +78,12 @@ pub struct PlannerConfig {
     /// (see the module docs). Default 16 (bisection alone would bring a
     /// 50 m bracket under a millimetre); it usually stops after 1 to 4.
     pub bisection_steps: u32,
+    /// Most objective-and-gradient evaluations of the optimizer per call,
+    /// ≥ 1 (the scan, the verification and the certification flights come
+    /// on top: they are what safety rests on). When it runs out the
+    /// optimizer stops where it is (`OptimizerStop::Budget`): it costs `J`,
+    /// never safety. Default `u32::MAX` (the iteration cap decides).
+    pub max_evaluations: u32,
 }
 
 impl Default for PlannerConfig {
@@ -96,6 +102,7 @@ impl Default for PlannerConfig {
             scan_points: 9,
             track_scan_points: 5,
             bisection_steps: 16,
+            max_evaluations: u32::MAX,
         }
     }
 }
@@ -131,6 +138,9 @@ impl PlannerConfig {
         if self.track_scan_points < 2 || self.track_scan_points > MAX_SCAN {
             return Err(PlanConfigError::TrackScanPoints);
         }
+        if self.max_evaluations == 0 {
+            return Err(PlanConfigError::MaxEvaluations);
+        }
         Ok(())
     }
 }
@@ -159,6 +169,8 @@ pub enum PlanConfigError {
     ScanPoints,
     /// `track_scan_points` is not in `2..=MAX_SCAN`.
     TrackScanPoints,
+    /// `max_evaluations` is 0.
+    MaxEvaluations,
 }
 
 impl PlanConfigError {
@@ -173,6 +185,7 @@ impl PlanConfigError {
             Self::SafetyMargin => "safety_margin",
             Self::ScanPoints => "scan_points",
             Self::TrackScanPoints => "track_scan_points",
+            Self::MaxEvaluations => "max_evaluations",
         }
     }
 }

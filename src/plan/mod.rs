@@ -82,6 +82,9 @@
 //! | `fallback.rs` | the closest safe depth, the safe-set boundary |
 
 mod answer;
+mod candidate;
+mod certify;
+mod commit;
 mod config;
 mod fallback;
 mod flights;
@@ -94,5 +97,5 @@ mod status;
 
 pub use answer::Plan;
 pub use config::{MAX_SCAN, Method, Mode, PlanConfigError, PlannerConfig};
-pub use planner::Planner;
-pub use status::{PlanError, PlanStatus};
+pub use planner::{MAX_TRACKS, Planner};
+pub use status::{OptimizerStop, PlanError, PlanStatus};

@@ -4,9 +4,9 @@
 use crate::optim::Objective;
 use crate::sim::{Scenario, SimError, TrackScore, VehicleState};
 
-/// Why [`PlanObjective`] did not return a value: the flight failed, or
-/// (a constrained single track) the optimizer has left the safe set and
-/// the boundary search takes over. An explicit stop, not an error
+/// Why [`PlanObjective`] did not return a value: the flight failed, the
+/// budget is spent, or (a constrained single track) the optimizer has left
+/// the safe set and the boundary search takes over. An explicit stop, not an error
 /// sentinel: the optimizer treats both as a failed trial.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Stop {
@@ -15,6 +15,8 @@ pub(super) enum Stop {
     /// A depth below the certified altitude was evaluated (see
     /// [`PlanObjective::guard`]); every later evaluation stops too.
     LeftSafeSet,
+    /// The evaluation budget is spent.
+    Budget,
 }
 
 /// `Φ(ζ) = Σ J + μ Σ V` over the horizon, with its exact gradient.
@@ -25,6 +27,8 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     pub count: usize,
     pub mu: f32,
     pub evaluations: u32,
+    /// Most evaluations; the next one after them stops.
+    pub budget: u32,
     /// `Σ V` at the last point evaluated: the optimizers' last evaluation
     /// is always the point they return.
     pub last_violation: f32,
@@ -59,6 +63,7 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             count,
             mu,
             evaluations: 0,
+            budget: u32::MAX,
             last_violation: 0.0,
             last_flight: None,
             guard: None,
@@ -74,6 +79,9 @@ impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
     fn eval(&mut self, z: &[f32; K]) -> Result<(f32, [f32; K]), Stop> {
         if self.tripped.is_some() {
             return Err(Stop::LeftSafeSet);
+        }
+        if self.evaluations >= self.budget {
+            return Err(Stop::Budget);
         }
         self.evaluations = self.evaluations.saturating_add(1);
         let e = self

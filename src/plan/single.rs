@@ -10,10 +10,11 @@
 
 use crate::optim::Outcome;
 
+use super::PlanError;
 use super::fallback::{Flown, boundary, fallback};
 use super::flights::Flights;
 use super::scan::ScanLog;
-use super::{PlanError, PlanStatus};
+use super::status::{Found, OptimizerStop};
 
 /// The finite-difference step, m, that checks a boundary optimum (`J` must
 /// not decrease into the safe set).
@@ -26,7 +27,7 @@ type End = (f32, Option<f32>);
 /// What the scan says of a single track.
 pub(super) enum Decision<const N: usize> {
     /// Answered without the optimizer.
-    Done(Flown<N>, PlanStatus),
+    Done(Flown<N>, Found),
     /// Optimize, from `z0` (with the scan's curvature unless `flat`).
     Optimize { z0: f32, flat: bool },
 }
@@ -51,7 +52,7 @@ pub(super) fn decide<const N: usize>(
                 score,
                 next,
             };
-            Ok(Decision::Done(f, PlanStatus::Infeasible))
+            Ok(Decision::Done(f, Found::Infeasible(OptimizerStop::None)))
         }
         Bracket::None => Ok(Decision::Optimize {
             z0: vertex,
@@ -82,7 +83,7 @@ pub(super) fn decide<const N: usize>(
                     flat: true,
                 })
             } else {
-                Ok(Decision::Done(b.at, PlanStatus::SafeFallback))
+                Ok(Decision::Done(b.at, Found::Boundary(OptimizerStop::None)))
             }
         }
     }
@@ -147,7 +148,7 @@ pub(super) fn tripped<const N: usize, const K: usize>(
     h_safe: f32,
     (scan_points, steps): (u32, u32),
     scan: &mut ScanLog,
-) -> Result<(Flown<N>, PlanStatus), PlanError> {
+) -> Result<(Flown<N>, Found), PlanError> {
     let good = match best_safe {
         Some((z, _, alt)) => Some((z, alt)),
         None => scan.nearest_safe(z_bad, h_safe).map(|e| (e.0, e.2)),
@@ -161,7 +162,7 @@ pub(super) fn tripped<const N: usize, const K: usize>(
                 h_safe,
                 steps,
             )?;
-            (b.at, PlanStatus::SafeFallback)
+            (b.at, Found::Boundary(OptimizerStop::Converged))
         }
         None => {
             let (f, safe) = fallback(
@@ -174,9 +175,9 @@ pub(super) fn tripped<const N: usize, const K: usize>(
                 scan,
             )?;
             let status = if safe {
-                PlanStatus::SafeFallback
+                Found::Boundary(OptimizerStop::Converged)
             } else {
-                PlanStatus::Infeasible
+                Found::Infeasible(OptimizerStop::Converged)
             };
             (f, status)
         }

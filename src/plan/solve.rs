@@ -23,13 +23,13 @@ pub(super) enum Merge {
     IfBetter,
 }
 
-impl<const K: usize> Planner<K> {
+impl<const K: usize, const N: usize> Planner<K, N> {
     /// Further penalty stages: each re-solves from the last optimum with
     /// `μ` a hundred times larger while that optimum still violates, at most
     /// `penalty_stages` in all (one for a single track, whose boundary
     /// search finds the safe boundary exactly), all within the one
     /// iteration cap. Returns the iterations so far.
-    pub(super) fn penalty_stages<const N: usize>(
+    pub(super) fn penalty_stages(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         (h, bounds): (usize, &Bounds<K>),
@@ -62,7 +62,7 @@ impl<const K: usize> Planner<K> {
     /// (model contract §10). Scan it over its box, the others held, and
     /// restart from anything better. Returns the iterations so far (a
     /// jump counts as one).
-    pub(super) fn escape_plateaus<const N: usize>(
+    pub(super) fn escape_plateaus(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         (h, bounds): (usize, &Bounds<K>),
@@ -100,7 +100,7 @@ impl<const K: usize> Planner<K> {
     /// The best point of a scan of coordinate `j` over its box when its
     /// gradient is exactly zero, if it beats the optimum by more than the
     /// stopping threshold.
-    fn plateau_jump<const N: usize>(
+    fn plateau_jump(
         &self,
         obj: &mut PlanObjective<'_, N>,
         bounds: &Bounds<K>,
@@ -134,7 +134,7 @@ impl<const K: usize> Planner<K> {
     /// workspace ends with) or, with [`Merge::IfBetter`], a restart kept
     /// only if it ends lower (its whole history). Returns the run's
     /// iterations, `None` when not kept.
-    pub(super) fn optimize_onto<const N: usize>(
+    pub(super) fn optimize_onto(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         z0: &[f32; K],
@@ -182,17 +182,20 @@ impl<const K: usize> Planner<K> {
                 optim::gd::gradient_descent_into(obj, z0, bounds, &gd, acc, continued)
             }
         };
-        run.map_err(|e| match e {
-            OptimError::Config(p) => PlanError::Config(p.into()),
-            OptimError::Start(Stop::Sim(e)) => PlanError::Sim(e),
-            OptimError::Start(Stop::LeftSafeSet) | OptimError::NonFinite => {
-                PlanError::Sim(SimError::Diverged)
-            }
-        })?;
+        // A run the budget does not allow to start is not a run.
+        let unstarted = matches!(run, Err(OptimError::Start(Stop::Budget)));
+        if !unstarted {
+            run.map_err(|e| match e {
+                OptimError::Config(p) => PlanError::Config(p.into()),
+                OptimError::Start(Stop::Sim(e)) => PlanError::Sim(e),
+                OptimError::Start(Stop::LeftSafeSet | Stop::Budget) | OptimError::NonFinite => {
+                    PlanError::Sim(SimError::Diverged)
+                }
+            })?;
+        }
         // (A NaN objective is not better either.)
-        if let Merge::IfBetter = merge
-            && acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less)
-        {
+        let worse = acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less);
+        if unstarted || (matches!(merge, Merge::IfBetter) && worse) {
             (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
             (acc.iterations, acc.evaluations, acc.skipped_updates) =
                 (kept_counts.0, kept_counts.1, kept_counts.2);

@@ -48,6 +48,9 @@ pub struct Scenario<'a, const N: usize> {
     penalty_altitude: f32,
     /// The world's kinematics (nominal unless [`Scenario::in_world`]).
     kin: Kinematics,
+    /// The bottom a planner certifies over (see
+    /// [`Scenario::with_certification_bottom`]).
+    certification: Option<ProfileView<'a>>,
 }
 
 impl<'a, const N: usize> Scenario<'a, N> {
@@ -92,7 +95,30 @@ impl<'a, const N: usize> Scenario<'a, N> {
             penalty_altitude: mission.min_altitude(),
             mission,
             kin,
+            certification: None,
         })
+    }
+
+    /// The same scenario with the bottom a planner certifies its plans
+    /// over under the mission's declared map uncertainty: the map's lower
+    /// envelope ([`crate::model::lower_envelope`]).
+    ///
+    /// # Errors
+    /// [`WaypointError::OutsideProfile`] when a waypoint lies outside
+    /// `bottom`.
+    pub fn with_certification_bottom(mut self, bottom: ProfileView<'a>) -> Result<Self, SimError> {
+        for (index, &x) in self.waypoints.positions().iter().enumerate() {
+            bottom
+                .depth_at(x)
+                .map_err(|_| WaypointError::OutsideProfile { index })?;
+        }
+        self.certification = Some(bottom);
+        Ok(self)
+    }
+
+    /// The certification bottom, if given.
+    pub fn certification_bottom(&self) -> Option<ProfileView<'a>> {
+        self.certification
     }
 
     /// The same line flown in `world` over `bottom` (e.g. the

@@ -1,0 +1,341 @@
+//! The candidate of one call: the track's depth as the optimizer (or the
+//! scan, or the boundary search) finds it for the horizon, in steps that
+//! each live in their own function: set-up (horizon, penalty, box), the
+//! starting point (warm start and scan), the single-track decision, the
+//! penalized solve with its plateau escape, verification and fallback.
+//! What is committed, and how safe it is, is `commit.rs`'s.
+
+use crate::optim::Bounds;
+use crate::sim::{Scenario, TrackScore, VehicleState};
+
+use super::fallback::{Flown, fallback};
+use super::flights::Flights;
+use super::objective::PlanObjective;
+use super::planner::Warm;
+use super::scan::{ScanLog, ScanSpec, scan_start, search_box};
+use super::single::{self, Decision};
+use super::solve::Merge;
+use super::status::{Found, OptimizerStop};
+use super::{Mode, PlanError, Planner};
+
+/// First step of a warm-started solve, relative to `first_step`.
+const WARM_FIRST_STEP: f32 = 0.1;
+
+/// What one call works with, fixed at its start.
+pub(super) struct Setup<const K: usize> {
+    /// Tracks optimized jointly.
+    pub h: usize,
+    warm: Option<Warm<K>>,
+    /// Penalty weight of the first stage (0: unconstrained).
+    mu: f32,
+    pub bounds: Bounds<K>,
+    /// Certified altitude `h_a + m_s`, m.
+    pub h_safe: f32,
+}
+
+/// The call's candidate for its track.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Candidate<const N: usize> {
+    /// The track's depth with its nominal flight.
+    pub flown: Flown<N>,
+    /// How it was found.
+    pub found: Found,
+    pub iterations: u32,
+    /// Flights so far.
+    pub evaluations: u32,
+    /// `h_a + m_s`, m.
+    pub h_safe: f32,
+}
+
+impl<const K: usize, const N: usize> Planner<K, N> {
+    /// The call's candidate for `track` from `state`: the optimized (or
+    /// scanned, or boundary) depth of the track with its nominal flight,
+    /// the rest of the horizon in the workspace, and the warm start kept.
+    pub(super) fn candidate(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+    ) -> Result<Candidate<N>, PlanError> {
+        let s = self.setup(sc, state, track)?;
+        // One track: no penalty margin, since the boundary search then
+        // lands on the exact safe boundary instead of `m_p` above it. A
+        // horizon keeps the margin for the tracks after the first, which no
+        // boundary search corrects.
+        let margin = if s.h == 1 {
+            0.0
+        } else {
+            self.cfg.penalty_margin
+        };
+        let penalized = sc.with_penalty_altitude(sc.mission().min_altitude() + margin);
+        let mut fl = Flights {
+            sc: penalized,
+            state,
+            track,
+            count: 0,
+        };
+        let mut scan = ScanLog::default();
+        let (mut z0, mut curvature, from) = self.start_point(&s, &mut fl, &mut scan)?;
+        // One track, constrained, scanned: the scan may decide it (module
+        // docs of `single`); it is then optimized without the penalty.
+        let single = s.h == 1 && self.cfg.constrained && from == 0 && !scan.is_empty();
+        if single {
+            let vertex = z0.first().copied().unwrap_or(0.0);
+            match single::decide(&mut fl, &scan, vertex, s.h_safe, self.cfg.bisection_steps)? {
+                Decision::Done(f, found) => {
+                    self.work.history.clear();
+                    let _ = self.work.history.push(f.score.j());
+                    return Ok(self.single_candidate(f, found, (0, fl.count), s.h_safe));
+                }
+                Decision::Optimize { z0: z, flat } => {
+                    if let Some(slot) = z0.first_mut() {
+                        *slot = z;
+                    }
+                    if flat {
+                        curvature = [0.0; K];
+                    }
+                }
+            }
+        }
+        let mu = if single { 0.0 } else { s.mu };
+        let mut obj = PlanObjective::new(penalized, state, track, s.h, mu);
+        obj.guard = single.then_some(s.h_safe);
+        obj.budget = self.cfg.max_evaluations;
+        let first_step = if s.warm.is_some() {
+            self.cfg.bfgs.first_step * WARM_FIRST_STEP
+        } else {
+            self.cfg.bfgs.first_step
+        };
+        let cap = self.cfg.bfgs.max_iterations;
+        let first = self.optimize_onto(
+            &mut obj,
+            &z0,
+            &s.bounds,
+            (first_step, cap),
+            &curvature,
+            Merge::First,
+        );
+        if let Some(t) = obj.tripped {
+            fl.count = fl.count.saturating_add(obj.evaluations);
+            return self.answer_tripped(&mut fl, &s, t, obj.best_safe, &mut scan);
+        }
+        first?;
+        let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
+        let iterations =
+            self.escape_plateaus(&mut obj, (s.h, &s.bounds), first_step, iterations)?;
+        fl.count = fl.count.saturating_add(obj.evaluations);
+        let spent = obj.evaluations >= obj.budget;
+        let (f, found) = self.verify(&mut fl, &s, (obj.last_flight, spent), &mut scan)?;
+        self.keep_warm(track, s.h, f.depth, obj.mu);
+        self.horizon_len = s.h;
+        Ok(Candidate {
+            flown: f,
+            found,
+            iterations,
+            evaluations: fl.count,
+            h_safe: s.h_safe,
+        })
+    }
+
+    /// The answer when a constrained single track's optimizer left the
+    /// safe set at `t` (see [`single::tripped`]).
+    fn answer_tripped(
+        &mut self,
+        fl: &mut Flights<'_, '_, N>,
+        s: &Setup<K>,
+        t: (f32, f32),
+        best_safe: Option<(f32, f32, f32)>,
+        scan: &mut ScanLog,
+    ) -> Result<Candidate<N>, PlanError> {
+        let lo = s.bounds.lo.first().copied().unwrap_or(t.0);
+        let hi = s.bounds.hi.first().copied().unwrap_or(t.0);
+        let (f, found) = single::tripped(
+            fl,
+            t,
+            best_safe,
+            &mut self.work,
+            (lo, hi),
+            s.h_safe,
+            (self.cfg.scan_points, self.cfg.bisection_steps),
+            scan,
+        )?;
+        let iterations = self.work.iterations;
+        Ok(self.single_candidate(f, found, (iterations, fl.count), s.h_safe))
+    }
+
+    /// The call's horizon, first penalty weight, box and certified
+    /// altitude; checks the track and the start state.
+    fn setup(
+        &self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+    ) -> Result<Setup<K>, PlanError> {
+        let remaining = sc
+            .waypoints()
+            .tracks()
+            .checked_sub(track)
+            .filter(|&r| r > 0)
+            .ok_or(PlanError::TrackRange)?;
+        // A bad start is the caller's error, named as such (every flight
+        // from it would fail the same way).
+        sc.check_start(state, track)?;
+        // Below the bottom nothing can be made safe. (The unconstrained
+        // study of the paper's bare objective flies on regardless.)
+        if self.cfg.constrained
+            && sc
+                .profile()
+                .depth_at(state.x())
+                .is_ok_and(|b| state.depth() > b)
+        {
+            return Err(PlanError::StartBelowBottom);
+        }
+        let h = match self.cfg.mode {
+            Mode::TrackWise => 1,
+            Mode::Horizon => self.cfg.horizon.min(K).min(remaining),
+        };
+        let warm = self.warm.filter(|w| w.track == track && w.len > 0);
+        let mu = match (self.cfg.constrained, warm) {
+            (false, _) => 0.0,
+            (true, Some(w)) => w.mu,
+            (true, None) => self.cfg.penalty_weight,
+        };
+        Ok(Setup {
+            h,
+            warm,
+            mu,
+            bounds: search_box::<N, K>(sc, state, track, h),
+            h_safe: sc.mission().min_altitude() + self.cfg.safety_margin,
+        })
+    }
+
+    /// The starting point: the warm start's depths, then a scan of the
+    /// tracks it does not cover. Returns the point, the scan's curvatures
+    /// and how many tracks the warm start covered.
+    fn start_point(
+        &self,
+        s: &Setup<K>,
+        fl: &mut Flights<'_, '_, N>,
+        scan: &mut ScanLog,
+    ) -> Result<([f32; K], [f32; K], usize), PlanError> {
+        let mut z0 = s.bounds.lo;
+        let mut from = 0;
+        if let Some(w) = s.warm {
+            from = w.len.min(s.h);
+            for (slot, &z) in z0.iter_mut().zip(w.depths.iter()).take(from) {
+                *slot = z;
+            }
+        }
+        let mut curvature = [0.0; K];
+        if from < s.h {
+            let points = if s.h == 1 && self.cfg.constrained {
+                self.cfg.track_scan_points
+            } else {
+                self.cfg.scan_points
+            };
+            let spec = ScanSpec {
+                bounds: &s.bounds,
+                from,
+                h: s.h,
+                points,
+                mu: s.mu,
+            };
+            scan_start(fl, &spec, &mut z0, &mut curvature, scan)?;
+        }
+        Ok((z0, curvature, from))
+    }
+
+    /// Verifies the committed depth by simulation (the optimizer's last
+    /// evaluation is that very point, so a single track's flight is at
+    /// hand) and falls back to the closest safe depth when it is not safe.
+    fn verify(
+        &self,
+        fl: &mut Flights<'_, '_, N>,
+        s: &Setup<K>,
+        (last, spent): (Option<(f32, TrackScore, VehicleState<N>)>, bool),
+        scan: &mut ScanLog,
+    ) -> Result<(Flown<N>, Found), PlanError> {
+        let z_opt = self.work.z.first().copied().unwrap_or_default();
+        let stop = if spent && self.work.status != crate::optim::Status::Converged {
+            OptimizerStop::Budget
+        } else {
+            OptimizerStop::from(self.work.status)
+        };
+        let (score, next) = match last {
+            // Same start, same depth, same track: the flight is identical.
+            Some((z, s, n)) if z.to_bits() == z_opt.to_bits() => (s, n),
+            _ => fl.fly(z_opt)?,
+        };
+        let flown = Flown {
+            depth: z_opt,
+            score,
+            next,
+        };
+        if !self.cfg.constrained || score.min_altitude() >= s.h_safe {
+            return Ok((flown, Found::Optimized(stop)));
+        }
+        let lo = s.bounds.lo.first().copied().unwrap_or(z_opt);
+        let hi = s.bounds.hi.first().copied().unwrap_or(z_opt);
+        let (f, safe) = fallback(
+            fl,
+            (z_opt, Some(score.min_altitude())),
+            (lo, hi),
+            s.h_safe,
+            self.cfg.scan_points,
+            self.cfg.bisection_steps,
+            scan,
+        )?;
+        let found = if safe {
+            Found::Boundary(stop)
+        } else {
+            Found::Infeasible(stop)
+        };
+        Ok((f, found))
+    }
+
+    /// Keeps the rest of the horizon for the next call (horizon mode).
+    fn keep_warm(&mut self, track: usize, h: usize, depth: f32, mu: f32) {
+        if let Some(first) = self.work.z.first_mut() {
+            *first = depth;
+        }
+        self.warm = (self.cfg.mode == Mode::Horizon && h > 1).then(|| {
+            let mut depths = [0.0; K];
+            for (dst, src) in depths.iter_mut().zip(self.work.z.iter().skip(1)) {
+                *dst = *src;
+            }
+            Warm {
+                track: track.saturating_add(1),
+                depths,
+                len: h.saturating_sub(1),
+                mu,
+            }
+        });
+    }
+
+    /// The candidate of a single-track solve decided without the general
+    /// path's verification (the depth's flight is at hand): no warm start,
+    /// the horizon is the depth alone, the objective its `J`.
+    fn single_candidate(
+        &mut self,
+        f: Flown<N>,
+        found: Found,
+        (iterations, evaluations): (u32, u32),
+        h_safe: f32,
+    ) -> Candidate<N> {
+        self.warm = None;
+        self.work.z = [0.0; K];
+        self.work.j = f.score.j();
+        self.work.grad_norm = 0.0;
+        if let Some(first) = self.work.z.first_mut() {
+            *first = f.depth;
+        }
+        self.horizon_len = 1;
+        Candidate {
+            flown: f,
+            found,
+            iterations,
+            evaluations,
+            h_safe,
+        }
+    }
+}

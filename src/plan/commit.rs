@@ -1,0 +1,353 @@
+//! What a call commits, and how safe it is (model contract §11, §12).
+//!
+//! **Horizon mode, constrained: recursive feasibility.** A depth is
+//! committed only with a *continuation*: reference depths for every later
+//! track, certified with it to the end of the line in every declared world
+//! ([`super::certify`]). The candidate continuation is the call's
+//! optimized horizon, then the previous call's continuation beyond it (or,
+//! with none, the shallowest allowed depth: the climb). If it does not
+//! certify, the call searches the straight path from a certified anchor —
+//! the previous call's continuation (flown from the state it predicted, so
+//! certified again whenever the vehicle flew the committed depth), else
+//! the shallowest depth on every track — towards the candidate, for the
+//! last certified point ([`crate::optim::root`] on the certified minimum
+//! altitude). With no anchor certified, the call is `infeasible` and
+//! commits the safest continuation it tried. So whatever the horizon, the
+//! iteration cap or the budget, once a call has committed a certified
+//! continuation every later call has one: fewer iterations cost `J`, never
+//! safety.
+//!
+//! **Track-wise mode** (the paper's) and **unconstrained** plans commit the
+//! candidate alone: its own track is certified and reported, nothing
+//! beyond it is promised.
+
+use crate::model::ProfileView;
+use crate::optim::root::{self, RootTol};
+use crate::sim::{Scenario, VehicleState, World};
+
+use super::candidate::Candidate;
+use super::certify::Certificate;
+use super::fallback::Flown;
+use super::flights::Flights;
+use super::planner::{Continuation, MAX_TRACKS};
+use super::status::Found;
+use super::{Mode, Plan, PlanError, PlanStatus, Planner};
+
+/// The certified-altitude tolerance of the continuation search, m (as the
+/// single track's boundary search: 0.2 % of `h_r − h_a`, 1 mm to 2 cm).
+const SEARCH_SHARE: f32 = 0.002;
+
+/// The search stops when the step along the path is this short (of 1).
+const SEARCH_WIDTH: f32 = 1e-3;
+
+/// The search path's ends: the certified anchor and the candidate, each
+/// with its certificate.
+type Ends<'c, const N: usize> = (
+    (&'c [f32; MAX_TRACKS], Certificate<N>),
+    (&'c [f32; MAX_TRACKS], Certificate<N>),
+);
+
+/// A continuation with its certificate.
+#[derive(Clone, Copy, Debug)]
+struct Chosen<const N: usize> {
+    depths: [f32; MAX_TRACKS],
+    len: usize,
+    cert: Certificate<N>,
+    /// Whether it was found on the search path (not the candidate itself).
+    searched: bool,
+}
+
+impl<const K: usize, const N: usize> Planner<K, N> {
+    /// Commits the call's depth: certifies it (with its continuation in
+    /// horizon mode), moves the worlds' states on, builds the one [`Plan`].
+    pub(super) fn commit(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+        cand: Candidate<N>,
+    ) -> Result<Plan<N>, PlanError> {
+        let bottom = certification_bottom(sc)?;
+        self.tube.prepare(
+            World::corners(sc.vehicle(), sc.mission().uncertainty()),
+            state,
+            track,
+        );
+        let mut flights = cand.evaluations;
+        let guaranteed = self.cfg.mode == Mode::Horizon && self.cfg.constrained;
+        let chosen = if guaranteed {
+            self.continue_safely(sc, bottom, track, &cand, &mut flights)?
+        } else {
+            let mut depths = [0.0; MAX_TRACKS];
+            depths[0] = cand.flown.depth;
+            let cert = self.tube.certify(sc, bottom, &depths[..1], &mut flights);
+            Chosen {
+                depths,
+                len: 1,
+                cert,
+                searched: false,
+            }
+        };
+        let depth = chosen.depths[0];
+        let flown = if depth.to_bits() == cand.flown.depth.to_bits() {
+            cand.flown
+        } else {
+            let mut fl = Flights {
+                sc: *sc,
+                state,
+                track,
+                count: flights,
+            };
+            let (score, next) = fl.fly(depth)?;
+            flights = fl.count;
+            Flown { depth, score, next }
+        };
+        self.keep(&chosen, track, guaranteed);
+        self.tube.advance(&chosen.cert, &flown.next);
+        let safe = chosen.cert.all >= cand.h_safe;
+        let status = self.status(sc, &cand, &chosen, safe);
+        Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
+    }
+
+    /// The continuation to commit (module docs): the candidate if it
+    /// certifies, else the last certified point on the path from an
+    /// anchor, else the safest tried.
+    fn continue_safely(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        track: usize,
+        cand: &Candidate<N>,
+        flights: &mut u32,
+    ) -> Result<Chosen<N>, PlanError> {
+        let len = sc.waypoints().tracks().saturating_sub(track);
+        if len > MAX_TRACKS {
+            return Err(PlanError::LineTooLong);
+        }
+        let shallow = sc.mission().depth_limits()[0];
+        let mut c = [shallow; MAX_TRACKS];
+        for (i, slot) in c.iter_mut().enumerate().take(len) {
+            let t = track.saturating_add(i);
+            *slot = match i {
+                0 => cand.flown.depth,
+                i if i < self.horizon_len => self.work.z.get(i).copied().unwrap_or(shallow),
+                _ => self.cont.depth(t).unwrap_or(shallow),
+            };
+        }
+        let cert_c = self.tube.certify(sc, bottom, &c[..len], flights);
+        let candidate = Chosen {
+            depths: c,
+            len,
+            cert: cert_c,
+            searched: false,
+        };
+        if cert_c.all >= cand.h_safe {
+            return Ok(candidate);
+        }
+        // The candidate's depth, then the climb: the optimized later depths
+        // may lead into a trap that the next call's horizon would see and
+        // avoid, while the committed depth alone need not.
+        let mut c2 = [shallow; MAX_TRACKS];
+        c2[0] = cand.flown.depth;
+        let cert_c2 = self.tube.certify(sc, bottom, &c2[..len], flights);
+        if cert_c2.all >= cand.h_safe {
+            return Ok(Chosen {
+                depths: c2,
+                len,
+                cert: cert_c2,
+                searched: false,
+            });
+        }
+        let (c, cert_c) = if cert_c2.all > cert_c.all {
+            (c2, cert_c2)
+        } else {
+            (c, cert_c)
+        };
+        // Anchors: the previous continuation, then the climb.
+        let prev = (0..len)
+            .all(|i| self.cont.depth(track.saturating_add(i)).is_some())
+            .then(|| {
+                let mut a = [shallow; MAX_TRACKS];
+                for (i, slot) in a.iter_mut().enumerate().take(len) {
+                    *slot = self.cont.depth(track.saturating_add(i)).unwrap_or(shallow);
+                }
+                a
+            });
+        let mut best = candidate;
+        for a in prev.into_iter().chain([[shallow; MAX_TRACKS]]) {
+            let cert_a = self.tube.certify(sc, bottom, &a[..len], flights);
+            if cert_a.all >= cand.h_safe {
+                let ends = ((&a, cert_a), (&c, cert_c));
+                return Ok(self.search(sc, bottom, ends, len, cand.h_safe, flights));
+            }
+            if cert_a.all > best.cert.all {
+                best = Chosen {
+                    depths: a,
+                    len,
+                    cert: cert_a,
+                    searched: true,
+                };
+            }
+        }
+        Ok(best)
+    }
+
+    /// The last certified point on the path `a + t (c − a)`, `t ∈ [0, 1]`,
+    /// from the certified anchor `a` towards the candidate `c`.
+    fn search(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        ((a, cert_a), (c, cert_c)): Ends<'_, N>,
+        len: usize,
+        h_safe: f32,
+        flights: &mut u32,
+    ) -> Chosen<N> {
+        let at = |t: f32| -> [f32; MAX_TRACKS] {
+            core::array::from_fn(|i| {
+                let (ai, ci) = (
+                    a.get(i).copied().unwrap_or(0.0),
+                    c.get(i).copied().unwrap_or(0.0),
+                );
+                ai + t * (ci - ai)
+            })
+        };
+        let m = sc.mission();
+        let rule = RootTol {
+            tol: (SEARCH_SHARE * (m.reference_altitude() - m.min_altitude())).clamp(1e-3, 0.02),
+            width: SEARCH_WIDTH,
+            steps: self.cfg.bisection_steps,
+        };
+        let (good, bad) = (
+            (0.0, Some(cert_a.all - h_safe)),
+            (1.0, Some(cert_c.all - h_safe)),
+        );
+        let r = root::safe_boundary(good, bad, rule, |t| {
+            let d = at(t);
+            let cert = self
+                .tube
+                .certify(sc, bottom, d.get(..len).unwrap_or(&[]), flights);
+            Ok::<_, ()>((cert.all - h_safe, cert))
+        });
+        let (t, cert) = match r {
+            Ok(root) => (root.z, root.at.unwrap_or(cert_a)),
+            Err(()) => (0.0, cert_a),
+        };
+        Chosen {
+            depths: if t > 0.0 { at(t) } else { *a },
+            len,
+            cert,
+            searched: true,
+        }
+    }
+
+    /// Keeps the committed continuation and, where the commit moved off
+    /// the candidate, restarts the warm start from the committed
+    /// continuation (a certified point).
+    fn keep(&mut self, chosen: &Chosen<N>, track: usize, guaranteed: bool) {
+        self.cont = Continuation::NONE;
+        if guaranteed {
+            self.cont.track = track.saturating_add(1);
+            self.cont.len = chosen.len.saturating_sub(1);
+            for (dst, src) in self
+                .cont
+                .depths
+                .iter_mut()
+                .zip(chosen.depths.iter().skip(1))
+            {
+                *dst = *src;
+            }
+        }
+        if let Some(first) = self.work.z.first_mut() {
+            *first = chosen.depths[0];
+        }
+        if chosen.searched
+            && let Some(w) = self.warm.as_mut()
+        {
+            for (dst, src) in w
+                .depths
+                .iter_mut()
+                .zip(chosen.depths.iter().skip(1))
+                .take(w.len)
+            {
+                *dst = *src;
+            }
+        }
+    }
+
+    /// What the plan is: not certified, infeasible; certified on the
+    /// constraint's boundary (found on it, or within the penalty margin
+    /// and 1 % of `h_r − h_a` of the certified altitude), constrained;
+    /// else optimal.
+    fn status(
+        &self,
+        sc: &Scenario<'_, N>,
+        cand: &Candidate<N>,
+        chosen: &Chosen<N>,
+        safe: bool,
+    ) -> PlanStatus {
+        let m = sc.mission();
+        let near = self.cfg.penalty_margin + 0.01 * (m.reference_altitude() - m.min_altitude());
+        if !safe {
+            PlanStatus::Infeasible
+        } else if chosen.searched
+            || matches!(cand.found, Found::Boundary(_) | Found::Infeasible(_))
+            || chosen.cert.first < cand.h_safe + near
+        {
+            PlanStatus::Constrained
+        } else {
+            PlanStatus::Optimal
+        }
+    }
+
+    /// The one place a [`Plan`] is built and logged.
+    fn answer(
+        &mut self,
+        f: Flown<N>,
+        chosen: &Chosen<N>,
+        cand: &Candidate<N>,
+        (status, safe): (PlanStatus, bool),
+        evaluations: u32,
+    ) -> Plan<N> {
+        let plan = Plan {
+            depth: f.depth,
+            status,
+            optimizer: cand.found.stop(),
+            safe,
+            j: f.score.j(),
+            rms: f.score.rms(),
+            min_altitude: f.score.min_altitude(),
+            certified_min_altitude: chosen.cert.first,
+            objective: self.work.j,
+            iterations: cand.iterations,
+            evaluations,
+            grad_norm: self.work.grad_norm,
+            horizon_len: self.horizon_len,
+            next_state: f.next,
+        };
+        crate::log::debug!(
+            "plan: depth {=f32} m, {=str} ({=str}), J {=f32} m3, min altitude {=f32} m (certified {=f32} m), {=u32} iterations, {=u32} evaluations",
+            plan.depth,
+            plan.status.as_str(),
+            plan.optimizer.as_str(),
+            plan.j,
+            plan.min_altitude,
+            plan.certified_min_altitude,
+            plan.iterations,
+            plan.evaluations
+        );
+        plan
+    }
+}
+
+/// The bottom certificates are flown over: the scenario's certification
+/// bottom, or the map itself when the map is declared exact.
+fn certification_bottom<'a, const N: usize>(
+    sc: &Scenario<'a, N>,
+) -> Result<ProfileView<'a>, PlanError> {
+    match sc.certification_bottom() {
+        Some(b) => Ok(b),
+        None if !sc.mission().uncertainty().map_uncertain() => Ok(sc.profile()),
+        None => Err(PlanError::NoCertificationBottom),
+    }
+}
