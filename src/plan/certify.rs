@@ -80,6 +80,29 @@ impl<const N: usize> Tube<N> {
         self.nominal = Some(*nominal);
     }
 
+    /// Whether the only world is the nominal one, starting from `state`:
+    /// then a nominal flight of one track from `state` over the map is its
+    /// certificate.
+    pub fn nominal_only(&self, nominal: &World, state: &VehicleState<N>) -> bool {
+        self.worlds.len() == 1
+            && self.worlds.first() == Some(nominal)
+            && self.states.first() == Some(state)
+    }
+
+    /// The certificate of a one-track continuation whose only world's
+    /// flight is at hand (see [`Tube::nominal_only`]).
+    pub fn from_flight(&self, min_altitude: f32, next: &VehicleState<N>) -> Certificate<N> {
+        let mut c = Certificate {
+            first: min_altitude,
+            all: min_altitude,
+            next: self.states,
+        };
+        if let Some(n) = c.next.first_mut() {
+            *n = *next;
+        }
+        c
+    }
+
     /// Forgets the worlds' states.
     pub fn reset(&mut self) {
         self.nominal = None;

@@ -76,11 +76,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut flights = cand.evaluations;
         let guaranteed = self.cfg.mode == Mode::Horizon && self.cfg.constrained;
         let chosen = if guaranteed {
-            self.continue_safely(sc, bottom, track, &cand, &mut flights)?
+            self.continue_safely(sc, bottom, (state, track), &cand, &mut flights)?
         } else {
             let mut depths = [0.0; MAX_TRACKS];
             depths[0] = cand.flown.depth;
-            let cert = self.tube.certify(sc, bottom, &depths[..1], &mut flights);
+            let cert = self.certify_one(sc, bottom, state, &cand.flown, &mut flights);
             Chosen {
                 depths,
                 len: 1,
@@ -116,7 +116,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
-        track: usize,
+        (state, track): (&VehicleState<N>, usize),
         cand: &Candidate<N>,
         flights: &mut u32,
     ) -> Result<Chosen<N>, PlanError> {
@@ -134,7 +134,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 _ => self.cont.depth(t).unwrap_or(shallow),
             };
         }
-        let cert_c = self.tube.certify(sc, bottom, &c[..len], flights);
+        let cert_c = if len == 1 {
+            self.certify_one(sc, bottom, state, &cand.flown, flights)
+        } else {
+            self.tube.certify(sc, bottom, &c[..len], flights)
+        };
         let candidate = Chosen {
             depths: c,
             len,
@@ -238,6 +242,25 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             len,
             cert,
             searched: true,
+        }
+    }
+
+    /// The certificate of the candidate's track alone: its nominal flight
+    /// when that is the only world over the map, else the worlds' flights.
+    fn certify_one(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        state: &VehicleState<N>,
+        flown: &Flown<N>,
+        flights: &mut u32,
+    ) -> Certificate<N> {
+        let over_map = bottom.positions().as_ptr() == sc.profile().positions().as_ptr();
+        if over_map && self.tube.nominal_only(&World::nominal(sc.vehicle()), state) {
+            self.tube
+                .from_flight(flown.score.min_altitude(), &flown.next)
+        } else {
+            self.tube.certify(sc, bottom, &[flown.depth], flights)
         }
     }
 
