@@ -42,8 +42,11 @@
 //!    Armijo line search, on a box.
 //! 4. [`plan`] — the main entry point: a [`Planner`] takes the vehicle
 //!    state at the start of the next track and returns that track's
-//!    reference depth ([`Plan`]), verified safe by simulation or flagged
-//!    [`PlanStatus::SafeFallback`] / [`PlanStatus::Infeasible`].
+//!    reference depth ([`Plan`]): in horizon mode committed only with a
+//!    continuation to the end of the line certified in every world of the
+//!    mission's declared [`Uncertainty`] ([`PlanStatus::Optimal`],
+//!    [`PlanStatus::Constrained`]), or flagged [`PlanStatus::Infeasible`]
+//!    by the first call that finds none.
 //!
 //! The model's equations, units and step order are in the repository's
 //! `docs/model.md`, in this crate's words.

@@ -85,8 +85,8 @@ VEHICLE.toml (every key optional, default shown; an unknown key is an error):
                                # between the surface (0) and the bottom
   depth_limits = [0.0, 6000.0] # allowed reference depths, m: exactly [min, max]
   # Declared uncertainty (model.md section 12), each finite and >= 0, default 0
-  # (0 = nominal model and map). Parsed and validated; not yet used by the
-  # planner, which then warns that safety is certified nominally only.
+  # (0 = nominal model and map). 'safe' is certified in every world of the
+  # declared set: the map's lower envelope, the vehicle's corner worlds.
   horizontal_uncertainty = 0.0 # e_h, m: map/navigation offset at waypoint 0
   nav_drift = 0.0              # r, m per m travelled (0.002 = 2 m per km)
   vertical_uncertainty = 0.0   # e_v, m: vertical map error

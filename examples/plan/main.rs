@@ -344,22 +344,9 @@ fn certify_open_loop(
 ) -> Result<Vec<(f32, bool)>, Fail> {
     let h_a = sc.mission().min_altitude();
     let bottom = sc.certification_bottom().unwrap_or(sc.profile());
-    let mut least = vec![f32::INFINITY; depths.len()];
-    for w in auvnav::World::corners(sc.vehicle(), sc.mission().uncertainty()) {
-        let scw = sc
-            .in_world(&w, bottom)
-            .map_err(|e| Fail::input(format!("certification: {e}")))?;
-        let mut scores = vec![TrackScore::default(); depths.len()];
-        match scw.simulate(start, 0, depths, &mut scores, |_| {}) {
-            Ok(_) => {
-                for (l, s) in least.iter_mut().zip(&scores) {
-                    *l = l.min(s.min_altitude());
-                }
-            }
-            // A world in which the flight fails is not certified.
-            Err(_) => least.iter_mut().for_each(|l| *l = f32::NEG_INFINITY),
-        }
-    }
+    let mut least = vec![0.0; depths.len()];
+    auvnav::plan::certify_line(sc, bottom, start, (0, depths), &mut least)
+        .map_err(|e| Fail::input(format!("certification: {e}")))?;
     Ok(least.into_iter().map(|m| (m, m >= h_a)).collect())
 }
 

@@ -173,7 +173,7 @@ pub fn lower_envelope<const S: usize>(
             // Keep the root of the branch it belongs to.
             if ((x + e - xj).abs() <= 1e-3 * (1.0 + xj.abs())
                 || (x - e - xj).abs() <= 1e-3 * (1.0 + xj.abs()))
-                && x != xj
+                && x.to_bits() != xj.to_bits()
             {
                 add(x, &mut at)?;
             }

@@ -79,23 +79,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // One track, constrained, scanned: the scan may decide it (module
         // docs of `single`); it is then optimized without the penalty.
         let single = s.h == 1 && self.cfg.constrained && from == 0 && !scan.is_empty();
-        if single {
-            let vertex = z0.first().copied().unwrap_or(0.0);
-            match single::decide(&mut fl, &scan, vertex, s.h_safe, self.cfg.bisection_steps)? {
-                Decision::Done(f, found) => {
-                    self.work.history.clear();
-                    let _ = self.work.history.push(f.score.j());
-                    return Ok(self.single_candidate(f, found, (0, fl.count), s.h_safe));
-                }
-                Decision::Optimize { z0: z, flat } => {
-                    if let Some(slot) = z0.first_mut() {
-                        *slot = z;
-                    }
-                    if flat {
-                        curvature = [0.0; K];
-                    }
-                }
-            }
+        if single
+            && let Some(done) =
+                self.single_decision(&mut fl, &scan, &s, (&mut z0, &mut curvature))?
+        {
+            return Ok(done);
         }
         let mu = if single { 0.0 } else { s.mu };
         let mut obj = PlanObjective::new(penalized, state, track, s.h, mu);
@@ -135,6 +123,40 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             evaluations: fl.count,
             h_safe: s.h_safe,
         })
+    }
+
+    /// The scan's decision of a constrained single track (module docs of
+    /// `single`): the candidate when it decides, else the start it gives
+    /// the optimizer, written into `z0` (and a flat metric if asked).
+    fn single_decision(
+        &mut self,
+        fl: &mut Flights<'_, '_, N>,
+        scan: &ScanLog,
+        s: &Setup<K>,
+        (z0, curvature): (&mut [f32; K], &mut [f32; K]),
+    ) -> Result<Option<Candidate<N>>, PlanError> {
+        let vertex = z0.first().copied().unwrap_or(0.0);
+        match single::decide(fl, scan, vertex, s.h_safe, self.cfg.bisection_steps)? {
+            Decision::Done(f, found) => {
+                self.work.history.clear();
+                let _ = self.work.history.push(f.score.j());
+                Ok(Some(self.single_candidate(
+                    f,
+                    found,
+                    (0, fl.count),
+                    s.h_safe,
+                )))
+            }
+            Decision::Optimize { z0: z, flat } => {
+                if let Some(slot) = z0.first_mut() {
+                    *slot = z;
+                }
+                if flat {
+                    *curvature = [0.0; K];
+                }
+                Ok(None)
+            }
+        }
     }
 
     /// The answer when a constrained single track's optimizer left the

@@ -11,17 +11,43 @@
 //! of the set. When the caller's start state is not the one the planner
 //! predicted (a closed loop replanning from a measured state), every world
 //! starts again from that state.
+//!
+//! The vehicle part of the certificate is sampled ([`World::corners`]: the
+//! corners and interior levels of the declared box). Between the samples
+//! the flight can dip lower where the autopilot saturates (measured: up
+//! to 0.75 m at `w_max` = 0.07 m/s on random lines). Every certified
+//! altitude is therefore lowered by a *vehicle margin*,
+//! `m_v = 15 s × (w_max + U0 sin α_max + U0 ε_U sin θmax)`: the depth the
+//! declared current, path offset and speed error can add over 15 s, the
+//! autopilot's reaction time (0 when nothing about the vehicle is
+//! declared). It is conservative by design, and costs `J` only when
+//! vehicle uncertainty is declared.
 
 use heapless::Vec;
 
-use crate::model::ProfileView;
+use crate::model::{ProfileView, Uncertainty, Vehicle};
+use crate::num::DEG;
 use crate::sim::{MAX_WORLDS, Scenario, SimError, TrackScore, VehicleState, World};
+
+/// The time over which the vehicle margin accumulates, s (module docs).
+const MARGIN_TIME: f32 = 15.0;
+
+/// The vehicle margin `m_v`, m (module docs).
+pub(super) fn vehicle_margin<const N: usize>(vehicle: &Vehicle<N>, u: &Uncertainty) -> f32 {
+    let u0 = vehicle.speed();
+    let pitch = vehicle.autopilot().config().pitch_limit * DEG;
+    let (sin_alpha, _) = crate::num::sin_cos(u.flight_path_offset() * DEG);
+    let (sin_pitch, _) = crate::num::sin_cos(pitch);
+    MARGIN_TIME * (u.vertical_current() + u0 * sin_alpha + u0 * u.speed() * sin_pitch)
+}
 
 /// The worlds of a certificate and each one's state at the start of
 /// `track`.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Tube<const N: usize> {
     worlds: Vec<World, MAX_WORLDS>,
+    /// The vehicle margin subtracted from every certified altitude, m.
+    margin: f32,
     states: [VehicleState<N>; MAX_WORLDS],
     /// The track those states start, and the nominal state they go with.
     track: usize,
@@ -32,6 +58,7 @@ impl<const N: usize> Default for Tube<N> {
     fn default() -> Self {
         Self {
             worlds: Vec::new(),
+            margin: 0.0,
             states: [VehicleState::trimmed(0.0, 0.0); MAX_WORLDS],
             track: 0,
             nominal: None,
@@ -57,10 +84,11 @@ impl<const N: usize> Tube<N> {
     /// worlds, else every world starts from `state`.
     pub fn prepare(
         &mut self,
-        worlds: Vec<World, MAX_WORLDS>,
+        (worlds, margin): (Vec<World, MAX_WORLDS>, f32),
         state: &VehicleState<N>,
         track: usize,
     ) {
+        self.margin = margin;
         let kept =
             self.track == track && self.nominal.as_ref() == Some(state) && self.worlds == worlds;
         if !kept {
@@ -84,14 +112,15 @@ impl<const N: usize> Tube<N> {
     /// then a nominal flight of one track from `state` over the map is its
     /// certificate.
     pub fn nominal_only(&self, nominal: &World, state: &VehicleState<N>) -> bool {
-        self.worlds.len() == 1
+        self.margin == 0.0
+            && self.worlds.len() == 1
             && self.worlds.first() == Some(nominal)
             && self.states.first() == Some(state)
     }
 
     /// The certificate of a one-track continuation whose only world's
     /// flight is at hand (see [`Tube::nominal_only`]).
-    pub fn from_flight(&self, min_altitude: f32, next: &VehicleState<N>) -> Certificate<N> {
+    pub fn of_flight(&self, min_altitude: f32, next: &VehicleState<N>) -> Certificate<N> {
         let mut c = Certificate {
             first: min_altitude,
             all: min_altitude,
@@ -128,8 +157,8 @@ impl<const N: usize> Tube<N> {
             };
             match fly_world(sc, w, bottom, st, self.track, depths, flights) {
                 Ok((first, all, end_first)) => {
-                    c.first = c.first.min(first);
-                    c.all = c.all.min(all);
+                    c.first = c.first.min(first - self.margin);
+                    c.all = c.all.min(all - self.margin);
                     *next = end_first;
                 }
                 Err(_) => {
@@ -172,4 +201,48 @@ fn fly_world<const N: usize>(
         }
     }
     Ok((first, all, end_first))
+}
+
+/// Certifies a fixed line (model contract §12): `depths` (one per track
+/// from `first`) flown open loop from `start` in every declared world over
+/// `bottom` (the certification bottom, or the map when the map is exact).
+/// Writes each track's least altitude over the worlds, less the vehicle
+/// margin (module docs), into `least` (m; `-inf` where a world's flight
+/// fails).
+///
+/// # Errors
+/// [`SimError`] for bad arguments (`least` shorter than `depths`, tracks
+/// past the line, a waypoint outside `bottom`).
+pub fn certify_line<const N: usize>(
+    sc: &Scenario<'_, N>,
+    bottom: ProfileView<'_>,
+    start: &VehicleState<N>,
+    (first, depths): (usize, &[f32]),
+    least: &mut [f32],
+) -> Result<(), SimError> {
+    let least = least.get_mut(..depths.len()).ok_or(SimError::ScoreBuffer)?;
+    least.iter_mut().for_each(|l| *l = f32::INFINITY);
+    let u = sc.mission().uncertainty();
+    let margin = vehicle_margin(sc.vehicle(), u);
+    for w in World::corners(sc.vehicle(), u) {
+        let scw = sc.in_world(&w, bottom)?;
+        let mut state = *start;
+        let mut score = [TrackScore::default()];
+        for (j, (l, &z)) in least.iter_mut().zip(depths).enumerate() {
+            match scw.simulate(&state, first.saturating_add(j), &[z], &mut score, |_| {}) {
+                Ok(next) => {
+                    state = next;
+                    let h = score
+                        .first()
+                        .map_or(f32::NEG_INFINITY, TrackScore::min_altitude);
+                    *l = l.min(h - margin);
+                }
+                Err(_) => {
+                    *l = f32::NEG_INFINITY;
+                    break;
+                }
+            }
+        }
+    }
+    Ok(())
 }

@@ -26,7 +26,7 @@ use crate::optim::root::{self, RootTol};
 use crate::sim::{Scenario, VehicleState, World};
 
 use super::candidate::Candidate;
-use super::certify::Certificate;
+use super::certify::{Certificate, vehicle_margin};
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::{Continuation, MAX_TRACKS};
@@ -68,11 +68,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         cand: Candidate<N>,
     ) -> Result<Plan<N>, PlanError> {
         let bottom = certification_bottom(sc)?;
-        self.tube.prepare(
-            World::corners(sc.vehicle(), sc.mission().uncertainty()),
-            state,
-            track,
+        let u = sc.mission().uncertainty();
+        let worlds = (
+            World::corners(sc.vehicle(), u),
+            vehicle_margin(sc.vehicle(), u),
         );
+        self.tube.prepare(worlds, state, track);
         let mut flights = cand.evaluations;
         let guaranteed = self.cfg.mode == Mode::Horizon && self.cfg.constrained;
         let chosen = if guaranteed {
@@ -125,19 +126,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return Err(PlanError::LineTooLong);
         }
         let shallow = sc.mission().depth_limits()[0];
-        let mut c = [shallow; MAX_TRACKS];
-        for (i, slot) in c.iter_mut().enumerate().take(len) {
-            let t = track.saturating_add(i);
-            *slot = match i {
-                0 => cand.flown.depth,
-                i if i < self.horizon_len => self.work.z.get(i).copied().unwrap_or(shallow),
-                _ => self.cont.depth(t).unwrap_or(shallow),
-            };
-        }
+        let c = self.candidate_continuation(track, len, cand.flown.depth, shallow);
         let cert_c = if len == 1 {
             self.certify_one(sc, bottom, state, &cand.flown, flights)
         } else {
-            self.tube.certify(sc, bottom, &c[..len], flights)
+            self.tube
+                .certify(sc, bottom, c.get(..len).unwrap_or(&[]), flights)
         };
         let candidate = Chosen {
             depths: c,
@@ -153,7 +147,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // avoid, while the committed depth alone need not.
         let mut c2 = [shallow; MAX_TRACKS];
         c2[0] = cand.flown.depth;
-        let cert_c2 = self.tube.certify(sc, bottom, &c2[..len], flights);
+        let cert_c2 = self
+            .tube
+            .certify(sc, bottom, c2.get(..len).unwrap_or(&[]), flights);
         if cert_c2.all >= cand.h_safe {
             return Ok(Chosen {
                 depths: c2,
@@ -179,7 +175,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             });
         let mut best = candidate;
         for a in prev.into_iter().chain([[shallow; MAX_TRACKS]]) {
-            let cert_a = self.tube.certify(sc, bottom, &a[..len], flights);
+            let cert_a = self
+                .tube
+                .certify(sc, bottom, a.get(..len).unwrap_or(&[]), flights);
             if cert_a.all >= cand.h_safe {
                 let ends = ((&a, cert_a), (&c, cert_c));
                 return Ok(self.search(sc, bottom, ends, len, cand.h_safe, flights));
@@ -194,6 +192,28 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         }
         Ok(best)
+    }
+
+    /// The candidate continuation: the call's depth, its optimized
+    /// horizon, then the previous continuation beyond it (or the climb to
+    /// `shallow`, m).
+    fn candidate_continuation(
+        &self,
+        track: usize,
+        len: usize,
+        depth: f32,
+        shallow: f32,
+    ) -> [f32; MAX_TRACKS] {
+        let mut c = [shallow; MAX_TRACKS];
+        for (i, slot) in c.iter_mut().enumerate().take(len) {
+            let t = track.saturating_add(i);
+            *slot = match i {
+                0 => depth,
+                i if i < self.horizon_len => self.work.z.get(i).copied().unwrap_or(shallow),
+                _ => self.cont.depth(t).unwrap_or(shallow),
+            };
+        }
+        c
     }
 
     /// The last certified point on the path `a + t (c − a)`, `t ∈ [0, 1]`,
@@ -257,8 +277,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Certificate<N> {
         let over_map = bottom.positions().as_ptr() == sc.profile().positions().as_ptr();
         if over_map && self.tube.nominal_only(&World::nominal(sc.vehicle()), state) {
-            self.tube
-                .from_flight(flown.score.min_altitude(), &flown.next)
+            self.tube.of_flight(flown.score.min_altitude(), &flown.next)
         } else {
             self.tube.certify(sc, bottom, &[flown.depth], flights)
         }

@@ -6,8 +6,10 @@
 //! state at X_{n-1}, waypoints, bottom ─► search box (reachable depths)
 //!   ─► start: coarse scan, track by track (or the previous call's plan)
 //!   ─► BFGS or GD on  Φ(ζ) = Σ J + μ Σ V          ζ = (z_n .. z_{n+h-1})
-//!   ─► verify z_n by simulation ─► safe? ─ no ─► closest safe depth (safe_fallback)
-//!                                              or the safest one (infeasible)
+//!   ─► verify z_n by simulation ─► safe? ─ no ─► closest safe depth, or the safest
+//!   ─► certify z_n with a continuation to the line's end in every declared world
+//!        (the horizon, then the climb; else a search from the last certified one)
+//!   ─► commit: optimal | constrained | infeasible, and the optimizer's stop
 //! ```
 //!
 //! **Modes.** Receding horizon (the default) optimizes the next `h <= K`
@@ -43,10 +45,10 @@
 //! the safe side in one to four plain flights, and a finite difference of `J` there (the search's
 //! previous safe depth, or one more flight) confirms that `J` does not
 //! decrease into the safe set; if it does, BFGS optimizes from there. When
-//! no scanned depth is safe the track is [`PlanStatus::Infeasible`] and the
-//! safest scanned depth is returned. Otherwise BFGS (without a penalty)
-//! optimizes from the scan's parabola vertex, and an unsafe optimum falls
-//! back to the boundary by the same search ([`PlanStatus::SafeFallback`]).
+//! no scanned depth is safe the track's candidate is the safest scanned
+//! depth. Otherwise BFGS (without a penalty) optimizes from the scan's
+//! parabola vertex, and an unsafe optimum falls back to the boundary by
+//! the same search.
 //!
 //! **Constraint, a horizon.** `h >= h_a` enters the optimization as a
 //! quadratic penalty: `Φ = Σ J + μ Σ V` with `V = ½ ∫ max(0, h_a + m_p − h)² dx`
@@ -57,23 +59,34 @@
 //! re-solves from the last optimum with `μ` a hundred times larger while
 //! that optimum still violates, for at most `penalty_stages` stages.
 //!
-//! **Verification.** The committed depth is **verified by simulation**: it
-//! is reported safe only when the track's minimum altitude is at least
-//! `h_a + m_s` (the safety margin, covering f32 vs f64 differences in
-//! altitude). If not, the planner looks for the safe depth closest to the
-//! optimum (among the scanned depths, then by the boundary search) and
-//! returns it flagged [`PlanStatus::SafeFallback`]; if no depth in the box
-//! is safe, it returns the safest depth it found, flagged
-//! [`PlanStatus::Infeasible`] with its predicted minimum altitude.
-//! With `constrained = false` (the paper's bare objective) there is no
-//! penalty and no fallback; safety is still verified and reported.
+//! **Verification.** The candidate depth is **verified by simulation** on
+//! its track: below `h_a + m_s` (the safety margin, covering f32 vs f64
+//! differences in altitude) the planner takes the safe depth closest to
+//! the optimum (among the scanned depths, then by the boundary search), or
+//! the safest depth it found.
+//!
+//! **Certification and commitment** (`commit.rs`, `certify.rs`). In
+//! horizon mode the depth is committed only with a continuation to the end
+//! of the line certified in every declared world (model contract §11,
+//! §12), so the flown line is safe whatever the horizon, the iteration cap
+//! or the budget, and [`PlanStatus::Infeasible`] comes from the first call
+//! that finds no certified continuation. The statuses: optimal (certified,
+//! the constraint not active), constrained (certified, on the boundary),
+//! infeasible; why the optimizer stopped is [`OptimizerStop`], apart.
+//! Track-wise mode (the paper's) certifies the committed track alone and
+//! promises nothing beyond it. With `constrained = false` (the paper's bare
+//! objective) there is no penalty and no fallback; the certificate is
+//! still flown and reported (an uncertified track is infeasible).
 //!
 //! | file | concern |
 //! |---|---|
 //! | `config.rs` | [`PlannerConfig`], [`Method`], [`Mode`], [`PlanConfigError`] |
-//! | `status.rs` | [`PlanStatus`], [`PlanError`] |
+//! | `status.rs` | [`PlanStatus`], [`OptimizerStop`], [`PlanError`] |
 //! | `answer.rs` | [`Plan`], the small answer |
-//! | `planner.rs` | [`Planner`]: one call, step by step |
+//! | `planner.rs` | [`Planner`]: the caller-owned planner and its entry point |
+//! | `candidate.rs` | one call's candidate, step by step |
+//! | `commit.rs` | what is committed: the certified continuation (§11) |
+//! | `certify.rs` | certificates over the declared worlds (§12), [`certify_line`] |
 //! | `flights.rs` | the call's plain flights, counted |
 //! | `solve.rs` | the optimizer runs: penalty stages, plateau escape |
 //! | `scan.rs` | the search box and the coarse scan (the starting point) |
@@ -96,6 +109,7 @@ mod solve;
 mod status;
 
 pub use answer::Plan;
+pub use certify::certify_line;
 pub use config::{MAX_SCAN, Method, Mode, PlanConfigError, PlannerConfig};
 pub use planner::{MAX_TRACKS, Planner};
 pub use status::{OptimizerStop, PlanError, PlanStatus};

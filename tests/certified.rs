@@ -1,0 +1,229 @@
+//! The certificate (model contract §12), tested by sampling the worlds it
+//! claims: lines planned under declared uncertainty, then their reported
+//! depths flown open loop in the corner worlds and in random interior ones
+//! (true speed, flight-path offset, vertical current; a map shifted along
+//! track by a random smooth `s(x)` and raised by a random `v(x)`, each
+//! within its bound). Every track reported safe must stay at or above
+//! `h_a` in every world. Also: the plan depends on the horizon setting,
+//! never on the planner's capacity `K`.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::float_cmp)]
+#![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
+
+mod common;
+
+use auvnav::{
+    Mission, Planner, PlannerConfig, Profile, Scenario, TrackScore, Uncertainty, Vehicle,
+    VehicleState, Waypoints, World, lower_envelope,
+};
+use common::{real_profile, real_waypoints};
+
+struct Lcg(u64);
+impl Lcg {
+    fn unit(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn sym(&mut self) -> f32 {
+        2.0 * self.unit() - 1.0
+    }
+}
+
+/// A world's bottom: `b(x + s(x)) + v(x)` on a 2 m grid, `s` and `v` sums
+/// of three random sinusoids scaled into their bounds (or, for `corner`,
+/// the constant extremes).
+fn world_bottom(
+    map: &Profile<4096>,
+    u: &Uncertainty,
+    x0: f32,
+    rng: &mut Lcg,
+    corner: Option<(f32, f32)>,
+) -> Profile<8192> {
+    let (a, b) = (map.start(), map.end());
+    let n = (((b - a) / 2.0) as usize).min(8000);
+    let waves: Vec<(f32, f32, f32)> = (0..3)
+        .map(|_| {
+            (
+                rng.sym(),
+                200.0 + 800.0 * rng.unit(),
+                std::f32::consts::TAU * rng.unit(),
+            )
+        })
+        .collect();
+    let shape = |x: f32, k: usize| -> f32 {
+        let s: f32 = waves
+            .iter()
+            .map(|&(amp, len, ph)| amp * (std::f32::consts::TAU * x / len + ph + k as f32).sin())
+            .sum();
+        (s / 3.0).clamp(-1.0, 1.0)
+    };
+    let xs: Vec<f32> = (0..=n).map(|i| a + (b - a) * i as f32 / n as f32).collect();
+    let bs: Vec<f32> = xs
+        .iter()
+        .map(|&x| {
+            let (fs, fv) = corner.unwrap_or((shape(x, 0), shape(x, 7)));
+            let s = fs * u.offset_at(x, x0);
+            let v = fv * u.vertical();
+            map.depth_at((x + s).clamp(a, b)).unwrap() + v
+        })
+        .collect();
+    Profile::new(&xs, &bs).unwrap()
+}
+
+/// The least altitude of each track of `depths` flown open loop from
+/// `start` in `world` over `bottom`.
+fn fly(
+    sc: &Scenario<'_, 3>,
+    world: &World,
+    bottom: &Profile<8192>,
+    start: &VehicleState<3>,
+    depths: &[f32],
+) -> Vec<f32> {
+    let scw = sc.in_world(world, bottom.view()).unwrap();
+    let mut s = vec![TrackScore::default(); depths.len()];
+    match scw.simulate(start, 0, depths, &mut s, |_| {}) {
+        Ok(_) => s.iter().map(TrackScore::min_altitude).collect(),
+        Err(_) => vec![f32::NEG_INFINITY; depths.len()],
+    }
+}
+
+#[test]
+fn every_track_reported_safe_is_safe_in_sampled_worlds() {
+    let vehicle = Vehicle::c_auv4().unwrap();
+    let mut rng = Lcg(0x5eed_2026_1201);
+    let (mut safe_tracks, mut worlds_flown) = (0, 0);
+    let lines = [
+        ("us_monterey_canyon_1", 80.0, 60.0),
+        ("us_monterey_canyon_2", 80.0, 60.0),
+        ("es_medes_islands_1", 5.0, 3.0),
+        ("es_medes_islands_2", 5.0, 3.0),
+    ];
+    for (name, h_r, h_a) in lines {
+        for draw in 0..3 {
+            let scale = if h_r > 10.0 { 1.0 } else { 0.1 };
+            let u = Uncertainty::new(
+                10.0 * scale * rng.unit(),
+                0.003 * rng.unit(),
+                5.0 * scale * rng.unit(),
+                0.1 * rng.unit(),
+                2.0 * rng.unit(),
+                if draw == 0 { 0.0 } else { 0.08 * rng.unit() },
+            )
+            .unwrap();
+            let (x, b) = real_profile(name);
+            let map = Profile::<4096>::new(&x, &b).unwrap();
+            let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+            let x0 = wps.positions()[0];
+            let env = lower_envelope::<12288>(map.view(), &u, x0).unwrap();
+            let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
+                .unwrap()
+                .with_uncertainty(u);
+            let sc = Scenario::new(&vehicle, &map, &wps, mission)
+                .unwrap()
+                .with_certification_bottom(env.view())
+                .unwrap();
+            let start = sc.start_state(sc.default_initial_depth());
+            let mut planner = Planner::<8>::new(PlannerConfig::default()).unwrap();
+            let (mut st, mut depths, mut safe) = (start, Vec::new(), Vec::new());
+            for n in 0..wps.tracks() {
+                let Ok(p) = planner.plan(&sc, &st, n) else {
+                    break;
+                };
+                depths.push(p.depth);
+                safe.push(p.safe);
+                st = p.next_state;
+            }
+            if depths.len() < wps.tracks() {
+                continue;
+            }
+            // The corners of the box and interior worlds at random.
+            let mut worlds: Vec<(World, Option<(f32, f32)>)> = Vec::new();
+            for k in 0..24 {
+                let u0 = vehicle.speed();
+                let w = if k < 8 {
+                    let c = |bit: usize| if k & bit == 0 { 1.0 } else { -1.0 };
+                    World {
+                        speed: u0 * (1.0 + c(1) * u.speed()),
+                        flight_path_offset: c(2) * u.flight_path_offset(),
+                        vertical_current: c(4) * u.vertical_current(),
+                    }
+                } else {
+                    World {
+                        speed: u0 * (1.0 + rng.sym() * u.speed()),
+                        flight_path_offset: rng.sym() * u.flight_path_offset(),
+                        vertical_current: rng.sym() * u.vertical_current(),
+                    }
+                };
+                let map_corner = (k < 8).then(|| if k % 2 == 0 { (1.0, 1.0) } else { (-1.0, 1.0) });
+                worlds.push((w, map_corner));
+            }
+            for (w, corner) in worlds {
+                let bottom = world_bottom(&map, &u, x0, &mut rng, corner);
+                let least = fly(&sc, &w, &bottom, &start, &depths);
+                worlds_flown += 1;
+                for (t, (&ok, &h)) in safe.iter().zip(&least).enumerate() {
+                    if ok {
+                        assert!(
+                            h >= h_a - 1e-2,
+                            "{name} draw {draw} track {}: reported safe, flies {h} < h_a {h_a} in {w:?} ({u:?})",
+                            t + 1
+                        );
+                    }
+                }
+            }
+            safe_tracks += safe.iter().filter(|&&s| s).count();
+        }
+    }
+    println!(
+        "{safe_tracks} tracks reported safe, each flown in {worlds_flown} sampled worlds in all"
+    );
+    assert!(
+        safe_tracks > 20,
+        "too few safe tracks to mean anything: {safe_tracks}"
+    );
+}
+
+#[test]
+fn the_plan_does_not_depend_on_the_capacity() {
+    let vehicle = Vehicle::c_auv4().unwrap();
+    for (name, h_r, h_a) in [
+        ("us_monterey_canyon_1", 80.0, 60.0),
+        ("us_monterey_canyon_2", 80.0, 60.0),
+        ("us_monterey_canyon_3", 80.0, 60.0),
+        ("es_medes_islands_1", 5.0, 3.0),
+        ("es_medes_islands_2", 5.0, 3.0),
+        ("jp_aburatsubo_sagami_1", 2.0, 1.0),
+    ] {
+        let (x, b) = real_profile(name);
+        let map = Profile::<4096>::new(&x, &b).unwrap();
+        let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+        let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
+        let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
+        for horizon in 1..=5 {
+            let cfg = PlannerConfig {
+                horizon,
+                ..PlannerConfig::default()
+            };
+            let mut five = Planner::<5>::new(cfg).unwrap();
+            let mut eight = Planner::<8>::new(cfg).unwrap();
+            let mut st = sc.start_state(sc.default_initial_depth());
+            for n in 0..wps.tracks() {
+                let (a, b) = (five.plan(&sc, &st, n), eight.plan(&sc, &st, n));
+                let (Ok(a), Ok(b)) = (a, b) else {
+                    break;
+                };
+                assert_eq!(
+                    a.depth.to_bits(),
+                    b.depth.to_bits(),
+                    "{name} horizon {horizon} track {n}: {} vs {}",
+                    a.depth,
+                    b.depth
+                );
+                assert_eq!(a, b, "{name} horizon {horizon} track {n}");
+                st = a.next_state;
+            }
+        }
+    }
+}
