@@ -18,14 +18,14 @@ START, END = "<!-- experiment:start -->", "<!-- experiment:end -->"
 
 
 def table(d):
-    rows = ["| track | depth m | J m³ | iterations | evaluations | min altitude m | safe | status |",
-            "|---:|---:|---:|---:|---:|---:|:---:|---|"]
+    rows = ["| track | depth m | J m³ | iterations | evaluations | min altitude m | safe | status | optimizer |",
+            "|---:|---:|---:|---:|---:|---:|:---:|---|---|"]
     for t in d["tracks"]:
         rows.append(f"| {t['track']} | {t['depth']:.1f} | {t['J']:.4g} | {t['iterations']} | "
-                    f"{t['evaluations']} | {t['min_altitude']:.2f} | {'yes' if t['safe'] else '**no**'} | {t['status']} |")
+                    f"{t['evaluations']} | {t['min_altitude']:.2f} | {'yes' if t['safe'] else '**no**'} | {t['status']} | {t['optimizer']} |")
     rows.append(f"| all | | **{d['total_J']:.4g}** | max {max(t['iterations'] for t in d['tracks'])} | "
                 f"{sum(t['evaluations'] for t in d['tracks'])} | **{d['min_altitude']:.2f}** | "
-                f"{'yes' if d['safe'] else '**no**'} | |")
+                f"{'yes' if d['safe'] else '**no**'} | | |")
     return "\n".join(rows)
 
 

@@ -23,6 +23,9 @@ cargo test --doc
 say "host: property tests, 10,000 random terrains (release)"
 cargo test --release --test properties -- --nocapture
 
+say "host: recursive feasibility, 1,500 random lines against a whole-line search; certificate in sampled worlds (release)"
+cargo test --release --test feasibility --test certified -- --nocapture
+
 say "target: the library builds for Cortex-M4F (thumbv7em-none-eabihf), with and without defmt"
 cargo build --lib --release --target thumbv7em-none-eabihf
 cargo build --lib --release --target thumbv7em-none-eabihf --features defmt

@@ -108,7 +108,7 @@ impl Report {
     /// The human-readable table.
     pub fn table(&self) -> String {
         let mut s = format!(
-            "method {}, mode {}\nprofile {}, vehicle {}, h_r {} m, h_a {} m\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>5} {:>5} {:>5}  {}\n",
+            "method {}, mode {}\nprofile {}, vehicle {}, h_r {} m, h_a {} m\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>9} {:>5} {:>5} {:>5}  {:<12} {}\n",
             self.method,
             self.mode,
             self.profile,
@@ -122,14 +122,16 @@ impl Report {
             "J m^3",
             "rms m",
             "min alt",
+            "certified",
             "safe",
             "iter",
             "eval",
-            "status"
+            "status",
+            "optimizer"
         );
         for (i, t) in self.tracks.iter().enumerate() {
             s += &format!(
-                "{:>5} {:>9.1} {:>9.1} {:>10.2} {:>14.1} {:>8.2} {:>9.2} {:>5} {:>5} {:>5}  {}\n",
+                "{:>5} {:>9.1} {:>9.1} {:>10.2} {:>14.1} {:>8.2} {:>9.2} {:>9.2} {:>5} {:>5} {:>5}  {:<12} {}\n",
                 i + 1,
                 t.x_start,
                 t.x_end,
@@ -137,10 +139,12 @@ impl Report {
                 t.j,
                 t.rms,
                 t.min_altitude,
+                t.certified_min_altitude,
                 if t.safe { "yes" } else { "NO" },
                 t.iterations,
                 t.evaluations,
-                t.status
+                t.status,
+                t.optimizer
             );
         }
         s += &format!(

@@ -66,16 +66,15 @@ impl<const N: usize> Default for Tube<N> {
     }
 }
 
-/// What a continuation's flights in every world showed.
+/// What a continuation's flights in every world showed (less the vehicle
+/// margin).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct Certificate<const N: usize> {
+pub(super) struct Certificate {
     /// Least altitude over the worlds on the committed track, m.
     pub first: f32,
     /// Least altitude over the worlds to the end of the line, m
     /// (`-inf` when a flight failed).
     pub all: f32,
-    /// Each world's state at the end of the committed track.
-    pub next: [VehicleState<N>; MAX_WORLDS],
 }
 
 impl<const N: usize> Tube<N> {
@@ -99,11 +98,39 @@ impl<const N: usize> Tube<N> {
         }
     }
 
-    /// After committing the track the tube starts: the worlds' states
-    /// the committed depth's certificate reached, with the nominal state
-    /// that goes with them.
-    pub fn advance(&mut self, cert: &Certificate<N>, nominal: &VehicleState<N>) {
-        self.states = cert.next;
+    /// After committing `depth` on the track the tube starts: each world's
+    /// state at the track's end, flown (or, when the nominal world over
+    /// the map is the only one, the nominal flight's `nominal`), with the
+    /// nominal state that goes with them. A world whose flight fails keeps
+    /// no state: the tube is forgotten, and the next call starts every
+    /// world afresh.
+    pub fn advance(
+        &mut self,
+        (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
+        depth: f32,
+        nominal: &VehicleState<N>,
+        (only_nominal, flights): (bool, &mut u32),
+    ) {
+        if only_nominal {
+            if let Some(s) = self.states.first_mut() {
+                *s = *nominal;
+            }
+        } else {
+            for (w, st) in self.worlds.iter().zip(self.states.iter_mut()) {
+                *flights = flights.saturating_add(1);
+                let mut score = [TrackScore::default()];
+                let next = sc
+                    .in_world(w, bottom)
+                    .and_then(|scw| scw.simulate(st, self.track, &[depth], &mut score, |_| {}));
+                match next {
+                    Ok(n) => *st = n,
+                    Err(_) => {
+                        self.nominal = None;
+                        return;
+                    }
+                }
+            }
+        }
         self.track = self.track.saturating_add(1);
         self.nominal = Some(*nominal);
     }
@@ -120,16 +147,11 @@ impl<const N: usize> Tube<N> {
 
     /// The certificate of a one-track continuation whose only world's
     /// flight is at hand (see [`Tube::nominal_only`]).
-    pub fn of_flight(&self, min_altitude: f32, next: &VehicleState<N>) -> Certificate<N> {
-        let mut c = Certificate {
+    pub fn of_flight(&self, min_altitude: f32) -> Certificate {
+        Certificate {
             first: min_altitude,
             all: min_altitude,
-            next: self.states,
-        };
-        if let Some(n) = c.next.first_mut() {
-            *n = *next;
         }
-        c
     }
 
     /// Forgets the worlds' states.
@@ -145,21 +167,16 @@ impl<const N: usize> Tube<N> {
         bottom: ProfileView<'_>,
         depths: &[f32],
         flights: &mut u32,
-    ) -> Certificate<N> {
+    ) -> Certificate {
         let mut c = Certificate {
             first: f32::INFINITY,
             all: f32::INFINITY,
-            next: self.states,
         };
-        for (i, w) in self.worlds.iter().enumerate() {
-            let (Some(st), Some(next)) = (self.states.get(i), c.next.get_mut(i)) else {
-                break;
-            };
+        for (w, st) in self.worlds.iter().zip(self.states.iter()) {
             match fly_world(sc, w, bottom, st, self.track, depths, flights) {
-                Ok((first, all, end_first)) => {
+                Ok((first, all)) => {
                     c.first = c.first.min(first - self.margin);
                     c.all = c.all.min(all - self.margin);
-                    *next = end_first;
                 }
                 Err(_) => {
                     c.first = f32::NEG_INFINITY;
@@ -172,7 +189,7 @@ impl<const N: usize> Tube<N> {
 }
 
 /// One world's flight of `depths` from `st` on `track`: the least altitude
-/// on the first track, to the end, and the state at the first track's end.
+/// on the first track, and to the end.
 fn fly_world<const N: usize>(
     sc: &Scenario<'_, N>,
     w: &World,
@@ -181,12 +198,11 @@ fn fly_world<const N: usize>(
     track: usize,
     depths: &[f32],
     flights: &mut u32,
-) -> Result<(f32, f32, VehicleState<N>), SimError> {
+) -> Result<(f32, f32), SimError> {
     let scw = sc.in_world(w, bottom)?;
     let mut score = [TrackScore::default()];
     let mut state = *st;
     let (mut first, mut all) = (f32::INFINITY, f32::INFINITY);
-    let mut end_first = state;
     // One flight of the line, flown track by track (runs chain exactly).
     *flights = flights.saturating_add(1);
     for (j, &z) in depths.iter().enumerate() {
@@ -197,10 +213,9 @@ fn fly_world<const N: usize>(
         all = all.min(h);
         if j == 0 {
             first = h;
-            end_first = state;
         }
     }
-    Ok((first, all, end_first))
+    Ok((first, all))
 }
 
 /// Certifies a fixed line (model contract §12): `depths` (one per track

@@ -26,7 +26,7 @@ use crate::optim::root::{self, RootTol};
 use crate::sim::{Scenario, VehicleState, World};
 
 use super::candidate::Candidate;
-use super::certify::{Certificate, vehicle_margin};
+use super::certify::{Certificate, Tube, vehicle_margin};
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::{Continuation, MAX_TRACKS};
@@ -43,8 +43,8 @@ const SEARCH_WIDTH: f32 = 1e-3;
 /// The search path's ends: the certified anchor and the candidate, each
 /// with its certificate.
 type Ends<'c, const N: usize> = (
-    (&'c [f32; MAX_TRACKS], Certificate<N>),
-    (&'c [f32; MAX_TRACKS], Certificate<N>),
+    (&'c [f32; MAX_TRACKS], Certificate),
+    (&'c [f32; MAX_TRACKS], Certificate),
 );
 
 /// A continuation with its certificate.
@@ -52,7 +52,7 @@ type Ends<'c, const N: usize> = (
 struct Chosen<const N: usize> {
     depths: [f32; MAX_TRACKS],
     len: usize,
-    cert: Certificate<N>,
+    cert: Certificate,
     /// Whether it was found on the search path (not the candidate itself).
     searched: bool,
 }
@@ -104,7 +104,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             Flown { depth, score, next }
         };
         self.keep(&chosen, track, guaranteed);
-        self.tube.advance(&chosen.cert, &flown.next);
+        let only_nominal = nominal_only(sc, bottom, &self.tube, state);
+        self.tube.advance(
+            (sc, bottom),
+            depth,
+            &flown.next,
+            (only_nominal, &mut flights),
+        );
         let safe = chosen.cert.all >= cand.h_safe;
         let status = self.status(sc, &cand, &chosen, safe);
         Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
@@ -274,10 +280,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         state: &VehicleState<N>,
         flown: &Flown<N>,
         flights: &mut u32,
-    ) -> Certificate<N> {
-        let over_map = bottom.positions().as_ptr() == sc.profile().positions().as_ptr();
-        if over_map && self.tube.nominal_only(&World::nominal(sc.vehicle()), state) {
-            self.tube.of_flight(flown.score.min_altitude(), &flown.next)
+    ) -> Certificate {
+        if nominal_only(sc, bottom, &self.tube, state) {
+            self.tube.of_flight(flown.score.min_altitude())
         } else {
             self.tube.certify(sc, bottom, &[flown.depth], flights)
         }
@@ -380,6 +385,18 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         );
         plan
     }
+}
+
+/// Whether the only world is the nominal one over the map, from `state`:
+/// the nominal flight is then the certificate.
+fn nominal_only<const N: usize>(
+    sc: &Scenario<'_, N>,
+    bottom: ProfileView<'_>,
+    tube: &Tube<N>,
+    state: &VehicleState<N>,
+) -> bool {
+    let over_map = bottom.positions().as_ptr() == sc.profile().positions().as_ptr();
+    over_map && tube.nominal_only(&World::nominal(sc.vehicle()), state)
 }
 
 /// The bottom certificates are flown over: the scenario's certification
