@@ -173,23 +173,17 @@ impl<const N: usize> Tube<N> {
             all: f32::INFINITY,
         };
         for (w, st) in self.worlds.iter().zip(self.states.iter()) {
-            match fly_world(sc, w, bottom, st, self.track, depths, flights) {
-                Ok((first, all)) => {
-                    c.first = c.first.min(first - self.margin);
-                    c.all = c.all.min(all - self.margin);
-                }
-                Err(_) => {
-                    c.first = f32::NEG_INFINITY;
-                    c.all = f32::NEG_INFINITY;
-                }
-            }
+            let (first, all) = fly_world(sc, w, bottom, st, self.track, depths, flights);
+            c.first = c.first.min(first - self.margin);
+            c.all = c.all.min(all - self.margin);
         }
         c
     }
 }
 
 /// One world's flight of `depths` from `st` on `track`: the least altitude
-/// on the first track, and to the end.
+/// on the first track, and to the end (`-inf` from the track on which a
+/// flight fails).
 fn fly_world<const N: usize>(
     sc: &Scenario<'_, N>,
     w: &World,
@@ -198,24 +192,35 @@ fn fly_world<const N: usize>(
     track: usize,
     depths: &[f32],
     flights: &mut u32,
-) -> Result<(f32, f32), SimError> {
-    let scw = sc.in_world(w, bottom)?;
+) -> (f32, f32) {
+    let Ok(scw) = sc.in_world(w, bottom) else {
+        return (f32::NEG_INFINITY, f32::NEG_INFINITY);
+    };
     let mut score = [TrackScore::default()];
     let mut state = *st;
     let (mut first, mut all) = (f32::INFINITY, f32::INFINITY);
     // One flight of the line, flown track by track (runs chain exactly).
     *flights = flights.saturating_add(1);
     for (j, &z) in depths.iter().enumerate() {
-        state = scw.simulate(&state, track.saturating_add(j), &[z], &mut score, |_| {})?;
-        let h = score
-            .first()
-            .map_or(f32::NEG_INFINITY, TrackScore::min_altitude);
+        let flown = scw.simulate(&state, track.saturating_add(j), &[z], &mut score, |_| {});
+        let h = match flown {
+            Ok(next) => {
+                state = next;
+                score
+                    .first()
+                    .map_or(f32::NEG_INFINITY, TrackScore::min_altitude)
+            }
+            Err(_) => f32::NEG_INFINITY,
+        };
         all = all.min(h);
         if j == 0 {
             first = h;
         }
+        if flown.is_err() {
+            break;
+        }
     }
-    Ok((first, all))
+    (first, all)
 }
 
 /// Certifies a fixed line (model contract §12): `depths` (one per track
