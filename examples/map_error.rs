@@ -272,7 +272,7 @@ fn main() {
     }
     out.push(String::new());
     out.push(format!(
-        "Declaring 3σ takes the flights below `h_a` from the nominal table's 80–95 % to the \
+        "Declaring 3σ takes the flights below `h_a` from the nominal table's figures (margin 20 m) to the \
          Gaussian tail beyond 3σ, with no collision. Where the line is not certified, the start \
          itself ({} m above the map) is already less than `h_a` + 3σ above the certification \
          bottom: no certified line exists from it, and the planner says so from the first call.",
