@@ -116,18 +116,7 @@ pub(crate) fn bfgs_with<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     cfg: &BfgsConfig,
     line_search: &L,
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
-    let mut out = Outcome::at(z0);
-    bfgs_into(
-        obj,
-        z0,
-        bounds,
-        cfg,
-        line_search,
-        &[0.0; K],
-        &mut out,
-        false,
-    )?;
-    Ok(out)
+    fresh(obj, z0, bounds, cfg, line_search, &[0.0; K])
 }
 
 /// [`bfgs`] from a known diagonal curvature: `A_0 = diag(curvature)`
@@ -144,13 +133,25 @@ pub fn bfgs_from<const K: usize, O: Objective<K>>(
     cfg: &BfgsConfig,
     curvature: &[f32; K],
 ) -> Result<Outcome<K>, OptimError<O::Error>> {
+    fresh(obj, z0, bounds, cfg, &cfg.armijo, curvature)
+}
+
+/// One run into a fresh [`Outcome`].
+fn fresh<const K: usize, O: Objective<K>, L: LineSearch<K>>(
+    obj: &mut O,
+    z0: &[f32; K],
+    bounds: &Bounds<K>,
+    cfg: &BfgsConfig,
+    line_search: &L,
+    curvature: &[f32; K],
+) -> Result<Outcome<K>, OptimError<O::Error>> {
     let mut out = Outcome::at(z0);
     bfgs_into(
         obj,
         z0,
         bounds,
         cfg,
-        &cfg.armijo,
+        line_search,
         curvature,
         &mut out,
         false,

@@ -153,9 +153,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // avoid, while the committed depth alone need not.
         let mut c2 = [shallow; MAX_TRACKS];
         c2[0] = cand.flown.depth;
-        let cert_c2 = self
-            .tube
-            .certify(sc, bottom, c2.get(..len).unwrap_or(&[]), flights);
+        // (The same line as the candidate when its tail is the climb
+        // already: its certificate is at hand.)
+        let same = c2.iter().zip(&c).all(|(a, b)| a.to_bits() == b.to_bits());
+        let cert_c2 = if same {
+            cert_c
+        } else {
+            self.tube
+                .certify(sc, bottom, c2.get(..len).unwrap_or(&[]), flights)
+        };
         if cert_c2.all >= cand.h_safe {
             return Ok(Chosen {
                 depths: c2,
@@ -170,15 +176,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (c, cert_c)
         };
         // Anchors: the previous continuation, then the climb.
-        let prev = (0..len)
-            .all(|i| self.cont.depth(track.saturating_add(i)).is_some())
-            .then(|| {
-                let mut a = [shallow; MAX_TRACKS];
-                for (i, slot) in a.iter_mut().enumerate().take(len) {
-                    *slot = self.cont.depth(track.saturating_add(i)).unwrap_or(shallow);
-                }
-                a
-            });
+        let prev = self.previous_continuation(track, len, shallow);
         let mut best = candidate;
         for a in prev.into_iter().chain([[shallow; MAX_TRACKS]]) {
             let cert_a = self
@@ -198,6 +196,21 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         }
         Ok(best)
+    }
+
+    /// The previous call's continuation for tracks `track..track + len`,
+    /// if it covers them all.
+    fn previous_continuation(
+        &self,
+        track: usize,
+        len: usize,
+        shallow: f32,
+    ) -> Option<[f32; MAX_TRACKS]> {
+        let mut a = [shallow; MAX_TRACKS];
+        for (i, slot) in a.iter_mut().enumerate().take(len) {
+            *slot = self.cont.depth(track.saturating_add(i))?;
+        }
+        Some(a)
     }
 
     /// The candidate continuation: the call's depth, its optimized
