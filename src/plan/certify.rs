@@ -173,7 +173,8 @@ impl<const N: usize> Tube<N> {
             all: f32::INFINITY,
         };
         for (w, st) in self.worlds.iter().zip(self.states.iter()) {
-            let (first, all) = fly_world(sc, w, bottom, st, self.track, depths, flights);
+            let at = (st, self.track);
+            let (first, all) = fly_world(sc, w, bottom, at, depths, (0.0, &mut []), flights);
             c.first = c.first.min(first - self.margin);
             c.all = c.all.min(all - self.margin);
         }
@@ -183,14 +184,16 @@ impl<const N: usize> Tube<N> {
 
 /// One world's flight of `depths` from `st` on `track`: the least altitude
 /// on the first track, and to the end (`-inf` from the track on which a
-/// flight fails).
+/// flight fails). Each track's altitude less `margin` also lowers the
+/// matching entry of `per_track` (which may be shorter, or empty).
+#[allow(clippy::too_many_arguments)]
 fn fly_world<const N: usize>(
     sc: &Scenario<'_, N>,
     w: &World,
     bottom: ProfileView<'_>,
-    st: &VehicleState<N>,
-    track: usize,
+    (st, track): (&VehicleState<N>, usize),
     depths: &[f32],
+    (margin, per_track): (f32, &mut [f32]),
     flights: &mut u32,
 ) -> (f32, f32) {
     let Ok(scw) = sc.in_world(w, bottom) else {
@@ -215,6 +218,9 @@ fn fly_world<const N: usize>(
         all = all.min(h);
         if j == 0 {
             first = h;
+        }
+        if let Some(l) = per_track.get_mut(j) {
+            *l = l.min(h - margin);
         }
         if flown.is_err() {
             break;
@@ -242,27 +248,22 @@ pub fn certify_line<const N: usize>(
 ) -> Result<(), SimError> {
     let least = least.get_mut(..depths.len()).ok_or(SimError::ScoreBuffer)?;
     least.iter_mut().for_each(|l| *l = f32::INFINITY);
+    // Every world shares the waypoints' check against `bottom`.
+    sc.in_world(&World::nominal(sc.vehicle()), bottom)?;
     let u = sc.mission().uncertainty();
     let margin = vehicle_margin(sc.vehicle(), u);
+    let mut flights = 0;
     for w in World::corners(sc.vehicle(), u) {
-        let scw = sc.in_world(&w, bottom)?;
-        let mut state = *start;
-        let mut score = [TrackScore::default()];
-        for (j, (l, &z)) in least.iter_mut().zip(depths).enumerate() {
-            match scw.simulate(&state, first.saturating_add(j), &[z], &mut score, |_| {}) {
-                Ok(next) => {
-                    state = next;
-                    let h = score
-                        .first()
-                        .map_or(f32::NEG_INFINITY, TrackScore::min_altitude);
-                    *l = l.min(h - margin);
-                }
-                Err(_) => {
-                    *l = f32::NEG_INFINITY;
-                    break;
-                }
-            }
-        }
+        let at = (start, first);
+        fly_world(
+            sc,
+            &w,
+            bottom,
+            at,
+            depths,
+            (margin, &mut *least),
+            &mut flights,
+        );
     }
     Ok(())
 }
