@@ -98,7 +98,9 @@ pub use plan::{
     Method, Mode, OptimizerStop, Plan, PlanConfigError, PlanError, PlanStatus, Planner,
     PlannerConfig,
 };
-pub use sim::{Evaluation, Sample, Scenario, SimError, TrackScore, VehicleState, World};
+pub use sim::{
+    Evaluation, Measurement, Sample, Scenario, SimError, TrackScore, VehicleState, World,
+};
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -10,10 +10,12 @@
 //! | `score.rs` | [`TrackScore`] and the one scoring kernel |
 //! | `lin.rs` | what a step and a scored piece linearize to |
 //! | `tangent.rs` | tangent states: [`Evaluation`], `∂J/∂z` by forward sensitivity |
+//! | `estimate.rs` | [`Measurement`]; the start state from what the vehicle measures |
 //! | `world.rs` | [`World`]: true speed, flight-path offset, vertical current |
 //! | `error.rs` | [`SimError`] |
 
 mod error;
+mod estimate;
 mod lin;
 mod run;
 mod score;
@@ -22,6 +24,7 @@ mod tangent;
 mod world;
 
 pub use error::SimError;
+pub use estimate::Measurement;
 pub use score::TrackScore;
 pub use state::{Sample, VehicleState};
 pub use tangent::Evaluation;
