@@ -115,6 +115,26 @@ pub fn waypoints(text: &str, name: &str) -> Result<Vec<f32>, Fail> {
     Ok(rows.iter().map(|r| r.1[0]).collect())
 }
 
+/// The positions of the waypoints of a CSV with `lat,lon` columns (for
+/// `--geojson` over a `--profile`), or an error saying how to get them.
+pub fn waypoint_positions(text: &str, name: &str, wx: &[f32]) -> Result<crate::map::Cut, Fail> {
+    let rows = csv(text, name, &["lat", "lon"]).map_err(|_| {
+        Fail::usage(format!(
+            "--geojson needs the waypoints' lat/lon: {name} has no lat,lon columns; give \
+             --grid GRID --line LINE, or waypoints with lat,lon columns"
+        ))
+    })?;
+    let pts: Vec<crate::map::line::LatLon> = rows
+        .iter()
+        .map(|r| crate::map::line::LatLon {
+            lat: f64::from(r.1[0]),
+            lon: f64::from(r.1[1]),
+        })
+        .collect();
+    let wx: Vec<f64> = wx.iter().map(|&x| f64::from(x)).collect();
+    Ok(crate::map::Cut::from_waypoints(&wx, &pts))
+}
+
 /// Checks that the first column strictly increases, naming the file line.
 fn increasing(rows: &[(usize, Vec<f32>)], name: &str, col: &str) -> Result<(), Fail> {
     for w in rows.windows(2) {

@@ -10,6 +10,7 @@
 mod args;
 mod fail;
 mod input;
+mod map;
 mod plot;
 mod report;
 
@@ -30,7 +31,16 @@ const ENVELOPE: usize = 3 * SAMPLES + 1;
 use report::{Report, TrackReport, TrajRow};
 
 fn main() -> ExitCode {
-    match run(Args::parse_os(std::env::args_os().skip(1))) {
+    // Subcommands by their first argument; anything else is the planner.
+    let mut argv = std::env::args_os().skip(1).peekable();
+    let result = match argv.peek().and_then(|a| a.to_str()) {
+        Some("profile") => {
+            argv.next();
+            map::profile_command(argv)
+        }
+        _ => run(Args::parse_os(argv)),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Fail::Help) => {
             println!("{}", args::USAGE);
@@ -46,15 +56,24 @@ fn main() -> ExitCode {
 fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let args = args?;
     // What the report calls the profile and the vehicle.
-    let profile_label = args.profile.as_ref().map_or_else(
-        || "us_monterey_canyon_1 (bundled)".to_string(),
-        |p| p.display().to_string(),
-    );
+    let profile_label = match (&args.profile, &args.grid, &args.line) {
+        (Some(p), _, _) => p.display().to_string(),
+        (_, Some(g), Some(l)) => format!("{} on {}", l.display(), g.display()),
+        _ => "us_monterey_canyon_1 (bundled)".to_string(),
+    };
     let vehicle_label = args.config.as_ref().map_or_else(
         || "C-AUV #4 (default)".to_string(),
         |p| p.display().to_string(),
     );
+    let mut cut = None;
     let (profile_text, profile_name, wp_text, wp_name) = match (&args.profile, &args.waypoints) {
+        _ if args.grid.is_some() => {
+            let (g, l) = (args.grid.as_deref(), args.line.as_deref());
+            let (g, l) = g.zip(l).ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
+            let (p, w, c) = map::profile_and_waypoints(g, l, args.spacing)?;
+            cut = Some(c);
+            (p, profile_label.clone(), w, l.display().to_string())
+        }
         (Some(p), Some(w)) => (
             input::read(p)?,
             p.display().to_string(),
@@ -79,6 +98,9 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let profile = Profile::<SAMPLES>::new(&px, &pb)
         .map_err(|e| Fail::input(format!("{profile_name}: {e}")))?;
     let wx = input::waypoints(&wp_text, &wp_name)?;
+    if args.geojson.is_some() && cut.is_none() {
+        cut = Some(input::waypoint_positions(&wp_text, &wp_name, &wx)?);
+    }
     let waypoints =
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
     let vehicle = Vehicle::new(&cfg.vehicle, cfg.plant)
@@ -151,7 +173,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let start = scenario.start_state(initial_depth);
     let mut scores = vec![TrackScore::default(); tracks];
     let mut rows = Vec::new();
-    let record = args.trajectory.is_some() || args.plot.is_some();
+    let record = args.trajectory.is_some() || args.plot.is_some() || args.geojson.is_some();
     let h_r = cfg.mission.reference_altitude();
     scenario
         .simulate(&start, 0, &report_base.depths, &mut scores, |s| {
@@ -232,6 +254,10 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
                 report: &report,
             },
         )?;
+    }
+    if let (Some(path), Some(c)) = (&args.geojson, &cut) {
+        let bottom = |x: f32| profile.depth_at(x).ok();
+        map::geojson::write(path, &map::geojson::plan(&report, c, &wx, &rows, &bottom))?;
     }
     if args.json {
         println!("{}", report.json());
