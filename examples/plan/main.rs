@@ -98,8 +98,14 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let profile = Profile::<SAMPLES>::new(&px, &pb)
         .map_err(|e| Fail::input(format!("{profile_name}: {e}")))?;
     let wx = input::waypoints(&wp_text, &wp_name)?;
-    if args.geojson.is_some() && cut.is_none() {
-        cut = Some(input::waypoint_positions(&wp_text, &wp_name, &wx)?);
+    if (args.geojson.is_some() || args.plot.is_some()) && cut.is_none() {
+        // The line on the map from waypoints with lat,lon columns: needed
+        // by --geojson, a map inset for --plot.
+        match input::waypoint_positions(&wp_text, &wp_name, &wx) {
+            Ok(c) => cut = Some(c),
+            Err(e) if args.geojson.is_some() => return Err(e),
+            Err(_) => {}
+        }
     }
     let waypoints =
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
@@ -203,6 +209,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         min_altitude_limit: h_a,
         method: report_base.method,
         mode: report_base.mode,
+        uncertainty: cfg.uncertainty,
         tracks: scores
             .iter()
             .zip(&report_base.depths)
@@ -238,8 +245,8 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
             path,
             &plot::Figure {
                 title: format!(
-                    "{} — {} / {}, total J {:.4e} m³, min altitude {:.2} m",
-                    profile_name,
+                    "{} — {} / {}, total J {:.3e} m³, min altitude {:.1} m",
+                    short_name(&report.profile),
                     report.method,
                     report.mode,
                     report.total_j(),
@@ -252,6 +259,10 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
                 min_altitude: h_a,
                 rows: &rows,
                 report: &report,
+                map: cut.as_ref().map(|c| {
+                    let ll = |p: &map::line::LatLon| (p.lon, p.lat);
+                    (c.at.iter().map(ll).collect(), c.waypoints.iter().map(|w| ll(&w.1)).collect())
+                }),
             },
         )?;
     }
@@ -265,6 +276,20 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         print!("{}", report.table());
     }
     Ok(())
+}
+
+/// A profile's name for a title: the file stems, not the whole paths
+/// (`monterey_1 on monterey_gebco`, `us_monterey_canyon_1 (bundled)`).
+fn short_name(label: &str) -> String {
+    label
+        .split(" on ")
+        .map(|p| {
+            std::path::Path::new(p)
+                .file_stem()
+                .map_or_else(|| p.to_string(), |s| s.to_string_lossy().into_owned())
+        })
+        .collect::<Vec<_>>()
+        .join(" on ")
 }
 
 /// Inputs that are valid numbers but cannot describe a real flight
