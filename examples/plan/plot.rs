@@ -318,7 +318,7 @@ fn inset(
     wps: &[(f64, f64)],
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (w, h) = area.dim_in_pixel();
-    let sub = area.shrink(((w as i32) - 300, (h as i32) - 250), (270, 190));
+    let sub = area.clone().shrink(((w as i32) - 300, (h as i32) - 250), (270, 190));
     sub.fill(&WHITE.mix(0.9))?;
     let (lo0, lo1, la0, la1) = line.iter().fold(
         (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY),
