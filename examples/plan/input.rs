@@ -104,7 +104,19 @@ pub fn profile(text: &str, name: &str) -> Result<(Vec<f32>, Vec<f32>), Fail> {
 
 /// Waypoints CSV (`wp,x_m`, more columns ignored): positions.
 pub fn waypoints(text: &str, name: &str) -> Result<Vec<f32>, Fail> {
-    let rows = csv(text, name, &["x_m"])?;
+    let rows = csv(text, name, &["x_m"]).map_err(|e| {
+        // A survey line in lat/lon only: say how to plan it.
+        let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+        let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+        if cols.contains(&"lat") && cols.contains(&"lon") && !cols.contains(&"x_m") {
+            Fail::input(format!(
+                "{name}: waypoints in lat,lon without x_m: cut the profile under the line from a \
+                 map with --grid GRID --line {name} (or plan profile --grid GRID --line {name})"
+            ))
+        } else {
+            e
+        }
+    })?;
     if rows.len() < 2 {
         return Err(Fail::input(format!(
             "{name}: need at least 2 waypoints (one track), found {}",
