@@ -880,7 +880,10 @@ fn outputs_name_the_declared_uncertainty() {
     }
     let text = String::from_utf8(run(&["--depths", "990,900,700,400,250"]).stdout).unwrap();
     assert!(
-        text.lines().nth(2).unwrap().starts_with("declared uncertainty: none"),
+        text.lines()
+            .nth(2)
+            .unwrap()
+            .starts_with("declared uncertainty: none"),
         "{text}"
     );
     let a = with_config(
@@ -912,21 +915,46 @@ fn plot_title_below_h_a_and_legend() {
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("g.svg");
     // 100 m deep over a bottom at 90-110 m with h_a = 60: below h_a.
-    let a = with(PROFILE, WAYPOINTS, &["--depths", "40,40", "--plot", out.to_str().unwrap()]);
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--depths", "40,40", "--plot", out.to_str().unwrap()],
+    );
     let o = run(&refs(&a));
-    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let svg = std::fs::read_to_string(&out).unwrap();
     let stem = Path::new(&a[1]).file_stem().unwrap().to_str().unwrap();
     let tmpdir = Path::new(&a[1]).parent().unwrap().to_str().unwrap();
-    assert!(svg.contains(&format!("{stem} — fixed")), "title lacks the stem {stem}");
+    assert!(
+        svg.contains(&format!("{stem} — fixed")),
+        "title lacks the stem {stem}"
+    );
     assert!(!svg.contains(tmpdir), "title holds the whole path");
-    assert!(svg.contains("below h_a (1 stretch"), "below-h_a stretches not marked");
-    assert!(!svg.contains("the line (lon, lat)"), "inset without lat/lon");
+    assert!(
+        svg.contains("below h_a (1 stretch"),
+        "below-h_a stretches not marked"
+    );
+    assert!(
+        !svg.contains("the line (lon, lat)"),
+        "inset without lat/lon"
+    );
     // A run above h_a everywhere marks nothing.
-    let a = with(PROFILE, WAYPOINTS, &["--depths", "20,20", "--plot", out.to_str().unwrap()]);
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--depths", "20,20", "--plot", out.to_str().unwrap()],
+    );
     assert_eq!(run(&refs(&a)).status.code(), Some(0));
     let svg = std::fs::read_to_string(&out).unwrap();
-    assert!(!svg.contains("below h_a ("), "marked though never below h_a");
+    assert!(
+        !svg.contains("below h_a ("),
+        "marked though never below h_a"
+    );
     // The legend's sample of the reference depth (grey, left of its
     // label): dashed as the lines are, so several short segments.
     let at = svg.find("reference depth z_n").unwrap();
@@ -949,5 +977,8 @@ fn plot_title_below_h_a_and_legend() {
             })
         })
         .count();
-    assert!(segments >= 2, "reference depth legend is not dashed ({segments} segment)");
+    assert!(
+        segments >= 2,
+        "reference depth legend is not dashed ({segments} segment)"
+    );
 }

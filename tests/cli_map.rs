@@ -31,7 +31,11 @@ fn tool() -> PathBuf {
     let p = dir
         .join("examples")
         .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
-    assert!(p.exists(), "{} not built: cargo build --examples", p.display());
+    assert!(
+        p.exists(),
+        "{} not built: cargo build --examples",
+        p.display()
+    );
     p
 }
 
@@ -139,38 +143,88 @@ fn agrees(grid: &str, line: &str, golden: &str, tol: f64) {
             p[0][k],
             g[0][k]
         );
-        assert!(db <= tol, "{grid}: depth at x = {} m: {} vs {}", g[0][k], p[1][k], g[1][k]);
+        assert!(
+            db <= tol,
+            "{grid}: depth at x = {} m: {} vs {}",
+            g[0][k],
+            p[1][k],
+            g[1][k]
+        );
         worst = (worst.0.max(dx), worst.1.max(db));
     }
     assert_eq!(w[1].len(), gw[1].len());
     for (x, gx) in w[1].iter().zip(&gw[1]) {
-        assert!((x - gx).abs() <= 1e-3 * gx.max(1.0), "{grid}: waypoint {x} vs {gx}");
-        assert!(p[0].contains(x), "{grid}: waypoint x = {x} m is not a sample");
+        assert!(
+            (x - gx).abs() <= 1e-3 * gx.max(1.0),
+            "{grid}: waypoint {x} vs {gx}"
+        );
+        assert!(
+            p[0].contains(x),
+            "{grid}: waypoint x = {x} m is not a sample"
+        );
     }
-    eprintln!("{grid} along {line}: worst |dx| {:.4} m, |d depth| {:.4} m", worst.0, worst.1);
+    eprintln!(
+        "{grid} along {line}: worst |dx| {:.4} m, |d depth| {:.4} m",
+        worst.0, worst.1
+    );
 }
 
 #[test]
 fn geotiff_agrees_with_the_independent_cut() {
-    agrees("grids/monterey_gebco.tif", "lines/monterey_1.csv", "monterey_1", 0.5);
-    agrees("grids/monterey_gebco.tif", "lines/monterey_2.csv", "monterey_2", 0.5);
+    agrees(
+        "grids/monterey_gebco.tif",
+        "lines/monterey_1.csv",
+        "monterey_1",
+        0.5,
+    );
+    agrees(
+        "grids/monterey_gebco.tif",
+        "lines/monterey_2.csv",
+        "monterey_2",
+        0.5,
+    );
 }
 
 #[test]
 fn esri_ascii_agrees_with_the_independent_cut() {
-    agrees("grids/monterey_gebco.asc", "lines/monterey_1.csv", "monterey_1", 0.5);
-    agrees("grids/monterey_gebco.asc", "lines/monterey_2.csv", "monterey_2", 0.5);
+    agrees(
+        "grids/monterey_gebco.asc",
+        "lines/monterey_1.csv",
+        "monterey_1",
+        0.5,
+    );
+    agrees(
+        "grids/monterey_gebco.asc",
+        "lines/monterey_2.csv",
+        "monterey_2",
+        0.5,
+    );
 }
 
 #[test]
 fn classic_netcdf_agrees_with_the_independent_cut() {
-    agrees("grids/monterey_gebco.nc", "lines/monterey_1.csv", "monterey_1", 0.5);
-    agrees("grids/monterey_gebco.nc", "lines/monterey_2.csv", "monterey_2", 0.5);
+    agrees(
+        "grids/monterey_gebco.nc",
+        "lines/monterey_1.csv",
+        "monterey_1",
+        0.5,
+    );
+    agrees(
+        "grids/monterey_gebco.nc",
+        "lines/monterey_2.csv",
+        "monterey_2",
+        0.5,
+    );
 }
 
 #[test]
 fn geojson_line_is_the_same_line() {
-    agrees("grids/monterey_gebco.tif", "lines/monterey_1.geojson", "monterey_1", 0.5);
+    agrees(
+        "grids/monterey_gebco.tif",
+        "lines/monterey_1.geojson",
+        "monterey_1",
+        0.5,
+    );
 }
 
 /// PixelIsPoint, float32, 16 × 16 tiles, a plane: bilinear is exact, so
@@ -179,10 +233,9 @@ fn geojson_line_is_the_same_line() {
 fn pixel_is_point_tiled_plane_is_exact() {
     agrees("grids/plane_point.tif", "lines/plane.csv", "plane", 0.01);
     let g = columns(&fixture("grids/golden/plane.csv"));
-    for k in 0..g[0].len() {
-        let (lat, lon) = (g[2][k], g[3][k]);
+    for ((b, lat), lon) in g[1].iter().zip(&g[2]).zip(&g[3]) {
         let plane = -(-3000.0 + 20.0 * lon - 30.0 * lat);
-        assert!((g[1][k] - plane).abs() < 0.01, "golden off the plane");
+        assert!((b - plane).abs() < 0.01, "golden off the plane");
     }
 }
 
@@ -193,8 +246,16 @@ fn pixel_is_point_tiled_plane_is_exact() {
 fn gebco_tile_is_read_by_window() {
     let path = fixture("grids/plane_gebco_tile.tif");
     let size = std::fs::metadata(&path).unwrap().len();
-    assert!(size < 21_600 * 21_600 * 2 / 1000, "{size} bytes: not sparse");
-    agrees("grids/plane_gebco_tile.tif", "lines/plane_tile.csv", "plane_tile", 0.5);
+    assert!(
+        size < 21_600 * 21_600 * 2 / 1000,
+        "{size} bytes: not sparse"
+    );
+    agrees(
+        "grids/plane_gebco_tile.tif",
+        "lines/plane_tile.csv",
+        "plane_tile",
+        0.5,
+    );
     // The tiles that are not stored cannot be decoded: a line over them
     // fails on that chunk, so the line above read none of them.
     let far = tmp_dir().join("far.csv");
@@ -202,20 +263,39 @@ fn gebco_tile_is_read_by_window() {
     let (p, w) = (tmp("far.p.csv"), tmp("far.w.csv"));
     let far = far.display().to_string();
     bad(
-        &["profile", "--grid", &path, "--line", &far, "--out-profile", &p, "--out-waypoints", &w],
+        &[
+            "profile",
+            "--grid",
+            &path,
+            "--line",
+            &far,
+            "--out-profile",
+            &p,
+            "--out-waypoints",
+            &w,
+        ],
         &["GeoTIFF chunk"],
     );
 }
 
 #[test]
 fn spacing_is_at_most_a_quarter_cell_or_the_given_one() {
-    let (g, l) = (fixture("grids/monterey_gebco.tif"), fixture("lines/monterey_1.csv"));
+    let (g, l) = (
+        fixture("grids/monterey_gebco.tif"),
+        fixture("lines/monterey_1.csv"),
+    );
     // 15" cells: about 372 m east-west at 36.7 N, 463 m north-south.
     for (extra, most) in [(vec![], 372.5 / 4.0), (vec!["--spacing", "10"], 10.0)] {
         let (p, w) = profile(&g, &l, &extra);
         let steps = p[0].windows(2).map(|s| s[1] - s[0]);
-        assert!(steps.clone().all(|d| d > 0.0 && d <= most + 1e-3), "{extra:?}");
-        assert!(steps.fold(0.0f64, f64::max) > 0.8 * most, "{extra:?}: too dense");
+        assert!(
+            steps.clone().all(|d| d > 0.0 && d <= most + 1e-3),
+            "{extra:?}"
+        );
+        assert!(
+            steps.fold(0.0f64, f64::max) > 0.8 * most,
+            "{extra:?}: too dense"
+        );
         for x in &w[1] {
             assert!(p[0].contains(x), "waypoint not on a sample");
         }
@@ -228,15 +308,26 @@ fn refs(v: &[String]) -> Vec<&str> {
 
 #[test]
 fn map_errors_name_the_waypoint() {
-    let out = ["--out-profile", &tmp("e.p.csv"), "--out-waypoints", &tmp("e.w.csv")];
+    let out = [
+        "--out-profile",
+        &tmp("e.p.csv"),
+        "--out-waypoints",
+        &tmp("e.w.csv"),
+    ];
     let cut = |grid: &str, line: &str| {
         let mut a = vec!["profile", "--grid", grid, "--line", line];
         a.extend(out);
         a.into_iter().map(String::from).collect::<Vec<_>>()
     };
-    let (tif, plane) = (fixture("grids/monterey_gebco.tif"), fixture("grids/plane_point.tif"));
+    let (tif, plane) = (
+        fixture("grids/monterey_gebco.tif"),
+        fixture("grids/plane_point.tif"),
+    );
     let a = cut(&tif, &fixture("lines/monterey_leaves.csv"));
-    bad(&refs(&a), &["track from waypoint 0 to 1", "leaves the grid"]);
+    bad(
+        &refs(&a),
+        &["track from waypoint 0 to 1", "leaves the grid"],
+    );
     let a = cut(&plane, &fixture("lines/plane_nodata.csv"));
     bad(&refs(&a), &["track from waypoint 0 to 1", "nodata"]);
     let a = cut(&plane, &fixture("lines/plane_land.csv"));
@@ -257,14 +348,27 @@ fn bad_grids_and_lines() {
         p.display().to_string()
     };
     let line = fixture("lines/monterey_1.csv");
-    let out = ["--out-profile", &tmp("b.p.csv"), "--out-waypoints", &tmp("b.w.csv")];
+    let out = [
+        "--out-profile",
+        &tmp("b.p.csv"),
+        "--out-waypoints",
+        &tmp("b.w.csv"),
+    ];
     let go = |grid: &str, line: &str, must: &[&str]| {
         let mut a = vec!["profile", "--grid", grid, "--line", line];
         a.extend(out);
         bad(&a, must);
     };
     let nc4 = write("g4.nc", b"\x89HDF\r\n\x1a\n\0\0\0\0\0\0\0\0");
-    go(&nc4, &line, &["NetCDF-4", "nccopy -k classic", "gdal_translate -of netCDF -co FORMAT=NC"]);
+    go(
+        &nc4,
+        &line,
+        &[
+            "NetCDF-4",
+            "nccopy -k classic",
+            "gdal_translate -of netCDF -co FORMAT=NC",
+        ],
+    );
     let utm = write(
         "utm.asc",
         b"ncols 2\nnrows 2\nxllcorner 517395\nyllcorner 4653795\ncellsize 10\n-1 -2\n-3 -4\n",
@@ -277,47 +381,119 @@ fn bad_grids_and_lines() {
     go(&short, &line, &["5 values", "3 x 2"]);
     go(&write("junk.asc", b"hello world\n"), &line, &["junk.asc:1"]);
     let tif = fixture("grids/monterey_gebco.tif");
-    go(&tif, &write("noll.csv", b"wp,x_m\n0,0\n1,100\n"), &["noll.csv:1", "'lat'"]);
-    go(&tif, &write("swap.csv", b"wp,lat,lon\n0,-122.0,36.7\n1,-122.1,36.7\n"), &["swap.csv:2", "swapped"]);
-    go(&tif, &write("blank.csv", b"wp,lat,lon\n0,36.71,-122.0\n\n1,36.7,x\n"), &["blank.csv:4", "lon 'x'"]);
-    go(&tif, &write("poly.geojson", br#"{"type":"Polygon","coordinates":[]}"#), &["LineString"]);
-    go(&tif, &write("one.csv", b"wp,lat,lon\n0,36.71,-122.0\n"), &["at least 2 waypoints"]);
-    go(&tif, &write("dup.csv", b"wp,lat,lon\n0,36.71,-122.0\n1,36.71,-122.0\n"), &["same point"]);
+    go(
+        &tif,
+        &write("noll.csv", b"wp,x_m\n0,0\n1,100\n"),
+        &["noll.csv:1", "'lat'"],
+    );
+    go(
+        &tif,
+        &write("swap.csv", b"wp,lat,lon\n0,-122.0,36.7\n1,-122.1,36.7\n"),
+        &["swap.csv:2", "swapped"],
+    );
+    go(
+        &tif,
+        &write("blank.csv", b"wp,lat,lon\n0,36.71,-122.0\n\n1,36.7,x\n"),
+        &["blank.csv:4", "lon 'x'"],
+    );
+    go(
+        &tif,
+        &write("poly.geojson", br#"{"type":"Polygon","coordinates":[]}"#),
+        &["LineString"],
+    );
+    go(
+        &tif,
+        &write("one.csv", b"wp,lat,lon\n0,36.71,-122.0\n"),
+        &["at least 2 waypoints"],
+    );
+    go(
+        &tif,
+        &write("dup.csv", b"wp,lat,lon\n0,36.71,-122.0\n1,36.71,-122.0\n"),
+        &["same point"],
+    );
 }
 
 #[test]
 fn profile_command_line() {
-    let (g, l) = (fixture("grids/monterey_gebco.tif"), fixture("lines/monterey_1.csv"));
+    let (g, l) = (
+        fixture("grids/monterey_gebco.tif"),
+        fixture("lines/monterey_1.csv"),
+    );
     let o = ok(&["profile", "--help"]);
     let help = String::from_utf8(o.stdout).unwrap();
-    for item in ["--grid", "--line", "--spacing", "--out-profile", "--out-waypoints", "quarter", "nccopy"] {
+    for item in [
+        "--grid",
+        "--line",
+        "--spacing",
+        "--out-profile",
+        "--out-waypoints",
+        "quarter",
+        "nccopy",
+    ] {
         assert!(help.contains(item), "plan profile --help lacks {item}");
     }
-    bad(&["profile", "--grid", &g, "--grid", &g], &["--grid given more than once"]);
-    bad(&["profile", "--grid", &g, "--line", &l], &["--out-profile is required"]);
-    bad(&["profile", "--bogus", "1"], &["unknown argument '--bogus'"]);
+    bad(
+        &["profile", "--grid", &g, "--grid", &g],
+        &["--grid given more than once"],
+    );
+    bad(
+        &["profile", "--grid", &g, "--line", &l],
+        &["--out-profile is required"],
+    );
+    bad(
+        &["profile", "--bogus", "1"],
+        &["unknown argument '--bogus'"],
+    );
     bad(&["profile", "--spacing", "-3"], &["--spacing"]);
     // The planner's own checks on the map options.
     bad(&["--grid", &g], &["--grid and --line go together"]);
     let csv = fixture("grids/golden/monterey_1.csv");
     bad(
-        &["--grid", &g, "--line", &l, "--profile", &csv, "--waypoints", &csv],
+        &[
+            "--grid",
+            &g,
+            "--line",
+            &l,
+            "--profile",
+            &csv,
+            "--waypoints",
+            &csv,
+        ],
         &["replace --profile/--waypoints"],
     );
     bad(&["--spacing", "10"], &["--spacing", "--grid"]);
-    bad(&["--grid", &g, "--line", &l, "--line", &l], &["--line given more than once"]);
+    bad(
+        &["--grid", &g, "--line", &l, "--line", &l],
+        &["--line given more than once"],
+    );
     // A lat/lon waypoint file given as --waypoints says to use --line.
     let p = fixture("grids/golden/monterey_1.csv");
-    bad(&["--profile", &p, "--waypoints", &l], &["--grid GRID --line"]);
+    bad(
+        &["--profile", &p, "--waypoints", &l],
+        &["--grid GRID --line"],
+    );
 }
 
 /// `plan --grid G --line L` plans exactly what `--profile/--waypoints`
 /// plans over `plan profile`'s files, and names the line and the grid.
 #[test]
 fn grid_line_plans_like_the_profile_it_cuts() {
-    let (g, l) = (fixture("grids/monterey_gebco.nc"), fixture("lines/monterey_1.csv"));
+    let (g, l) = (
+        fixture("grids/monterey_gebco.nc"),
+        fixture("lines/monterey_1.csv"),
+    );
     let (p, w) = (tmp("plan.p.csv"), tmp("plan.w.csv"));
-    ok(&["profile", "--grid", &g, "--line", &l, "--out-profile", &p, "--out-waypoints", &w]);
+    ok(&[
+        "profile",
+        "--grid",
+        &g,
+        "--line",
+        &l,
+        "--out-profile",
+        &p,
+        "--out-waypoints",
+        &w,
+    ]);
     let depths = ["--depths", "990,840,720,200,100", "--json"];
     let mut a = vec!["--grid", g.as_str(), "--line", l.as_str()];
     a.extend(depths);
@@ -328,26 +504,46 @@ fn grid_line_plans_like_the_profile_it_cuts() {
     assert_eq!(from_grid["tracks"], from_csv["tracks"]);
     assert_eq!(from_grid["total_J"], from_csv["total_J"]);
     let name = from_grid["profile"].as_str().unwrap();
-    assert!(name.contains("monterey_1.csv") && name.contains("monterey_gebco.nc"), "{name}");
+    assert!(
+        name.contains("monterey_1.csv") && name.contains("monterey_gebco.nc"),
+        "{name}"
+    );
 }
 
 fn is_position(v: &Value, dims: usize) -> bool {
-    v.as_array().is_some_and(|a| a.len() == dims && a.iter().all(Value::is_f64))
+    v.as_array()
+        .is_some_and(|a| a.len() == dims && a.iter().all(Value::is_f64))
 }
 
 /// RFC 7946: a FeatureCollection of Features, positions [lon, lat(, h)],
 /// the documented properties.
 #[test]
 fn geojson_plan_is_rfc7946_with_the_documented_properties() {
-    let (g, l) = (fixture("grids/monterey_gebco.tif"), fixture("lines/monterey_1.csv"));
+    let (g, l) = (
+        fixture("grids/monterey_gebco.tif"),
+        fixture("lines/monterey_1.csv"),
+    );
     let out = tmp("plan.geojson");
-    let o = ok(&["--grid", &g, "--line", &l, "--mode", "track", "--json", "--geojson", &out]);
+    let o = ok(&[
+        "--grid",
+        &g,
+        "--line",
+        &l,
+        "--mode",
+        "track",
+        "--json",
+        "--geojson",
+        &out,
+    ]);
     let plan: Value = serde_json::from_slice(&o.stdout).unwrap();
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(v["type"], "FeatureCollection");
     let feats = v["features"].as_array().unwrap();
     let line = columns(&l);
-    let wps: Vec<&Value> = feats.iter().filter(|f| f["properties"]["kind"] == "waypoint").collect();
+    let wps: Vec<&Value> = feats
+        .iter()
+        .filter(|f| f["properties"]["kind"] == "waypoint")
+        .collect();
     assert_eq!(wps.len(), line[0].len());
     for (i, f) in wps.iter().enumerate() {
         assert_eq!(f["type"], "Feature");
@@ -373,7 +569,10 @@ fn geojson_plan_is_rfc7946_with_the_documented_properties() {
             }
         }
     }
-    let traj: Vec<&Value> = feats.iter().filter(|f| f["properties"]["kind"] == "trajectory").collect();
+    let traj: Vec<&Value> = feats
+        .iter()
+        .filter(|f| f["properties"]["kind"] == "trajectory")
+        .collect();
     assert_eq!(traj.len(), 1);
     let t = traj[0];
     assert_eq!(t["geometry"]["type"], "LineString");
@@ -386,7 +585,13 @@ fn geojson_plan_is_rfc7946_with_the_documented_properties() {
         assert!((36.69..36.72).contains(&c[1].as_f64().unwrap()), "{c}");
         assert_eq!(c[2].as_f64().unwrap(), -d.as_f64().unwrap());
     }
-    for k in ["profile", "vehicle", "reference_altitude_m", "min_altitude_limit_m", "safe"] {
+    for k in [
+        "profile",
+        "vehicle",
+        "reference_altitude_m",
+        "min_altitude_limit_m",
+        "safe",
+    ] {
         assert!(!t["properties"][k].is_null(), "trajectory lacks {k}");
     }
 }
@@ -397,16 +602,36 @@ fn geojson_needs_positions() {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/bathymetry");
     let (p, w) = (
         data.join("us_monterey_canyon_1.csv").display().to_string(),
-        data.join("us_monterey_canyon_1.waypoints.csv").display().to_string(),
+        data.join("us_monterey_canyon_1.waypoints.csv")
+            .display()
+            .to_string(),
     );
     let out = tmp("csv.geojson");
-    ok(&["--profile", &p, "--waypoints", &w, "--depths", "990,900,700,400,250", "--geojson", &out]);
+    ok(&[
+        "--profile",
+        &p,
+        "--waypoints",
+        &w,
+        "--depths",
+        "990,900,700,400,250",
+        "--geojson",
+        &out,
+    ]);
     let v: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(v["features"].as_array().unwrap().len(), 7);
     let nolatlon = tmp_dir().join("w.csv");
     std::fs::write(&nolatlon, "wp,x_m\n0,0\n1,1000\n").unwrap();
     bad(
-        &["--profile", &p, "--waypoints", nolatlon.to_str().unwrap(), "--depths", "500", "--geojson", &out],
+        &[
+            "--profile",
+            &p,
+            "--waypoints",
+            nolatlon.to_str().unwrap(),
+            "--depths",
+            "500",
+            "--geojson",
+            &out,
+        ],
         &["--geojson needs the waypoints' lat/lon"],
     );
 }

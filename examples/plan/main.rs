@@ -69,7 +69,9 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let (profile_text, profile_name, wp_text, wp_name) = match (&args.profile, &args.waypoints) {
         _ if args.grid.is_some() => {
             let (g, l) = (args.grid.as_deref(), args.line.as_deref());
-            let (g, l) = g.zip(l).ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
+            let (g, l) = g
+                .zip(l)
+                .ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
             let (p, w, c) = map::profile_and_waypoints(g, l, args.spacing)?;
             cut = Some(c);
             (p, profile_label.clone(), w, l.display().to_string())
@@ -261,7 +263,10 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
                 report: &report,
                 map: cut.as_ref().map(|c| {
                     let ll = |p: &map::line::LatLon| (p.lon, p.lat);
-                    (c.at.iter().map(ll).collect(), c.waypoints.iter().map(|w| ll(&w.1)).collect())
+                    (
+                        c.at.iter().map(ll).collect(),
+                        c.waypoints.iter().map(|w| ll(&w.1)).collect(),
+                    )
                 }),
             },
         )?;

@@ -23,8 +23,11 @@ pub struct Figure<'a> {
     pub report: &'a Report,
     /// The line on the map, (lon, lat) of its samples and of its
     /// waypoints, when known (`--grid/--line`, waypoints with lat/lon).
-    pub map: Option<(Vec<(f64, f64)>, Vec<(f64, f64)>)>,
+    pub map: Option<MapLine>,
 }
+
+/// (lon, lat) of a line's samples and of its waypoints.
+pub type MapLine = (Vec<(f64, f64)>, Vec<(f64, f64)>);
 
 const TRACK_COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
@@ -301,10 +304,14 @@ fn below_min_altitude(
             orange.mix(0.25).filled(),
         )))?;
         if i == 0 {
-            s.label(format!("below h_a ({} stretch{})", spans.len(), if spans.len() == 1 { "" } else { "es" }))
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 20, y + 5)], orange.mix(0.5).filled())
-                });
+            s.label(format!(
+                "below h_a ({} stretch{})",
+                spans.len(),
+                if spans.len() == 1 { "" } else { "es" }
+            ))
+            .legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 20, y + 5)], orange.mix(0.5).filled())
+            });
         }
     }
     Ok(())
@@ -318,10 +325,17 @@ fn inset(
     wps: &[(f64, f64)],
 ) -> Result<(), Box<dyn std::error::Error>> {
     let (w, h) = area.dim_in_pixel();
-    let sub = area.clone().shrink(((w as i32) - 300, (h as i32) - 250), (270, 190));
+    let sub = area
+        .clone()
+        .shrink(((w as i32) - 300, (h as i32) - 250), (270, 190));
     sub.fill(&WHITE.mix(0.9))?;
     let (lo0, lo1, la0, la1) = line.iter().fold(
-        (f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY),
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
         |(a, b, c, d), &(x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
     );
     // Equal scales on the ground: a degree of longitude is cos(lat) of one
@@ -343,7 +357,10 @@ fn inset(
         .label_style(("sans-serif", 10))
         .light_line_style(WHITE.mix(0.0))
         .draw()?;
-    c.draw_series(LineSeries::new(line.iter().copied(), RGBColor(20, 60, 200).stroke_width(2)))?;
+    c.draw_series(LineSeries::new(
+        line.iter().copied(),
+        RGBColor(20, 60, 200).stroke_width(2),
+    ))?;
     c.draw_series(wps.iter().map(|&p| Circle::new(p, 3, BLACK.filled())))?;
     c.draw_series(
         wps.iter()

@@ -100,7 +100,10 @@ pub fn cut(src: &mut dyn Source, name: &str, line: &[LatLon], ds: f64) -> Result
         ))
     };
     let inside = |f: f64, n: usize| f >= -1e-9 && f <= n as f64 - 1.0 + 1e-9;
-    if let Some(k) = frac.iter().position(|&(r, c)| !inside(r, g.rows) || !inside(c, g.cols)) {
+    if let Some(k) = frac
+        .iter()
+        .position(|&(r, c)| !inside(r, g.rows) || !inside(c, g.cols))
+    {
         return Err(leaves(k));
     }
     // The window of nodes the samples need, and only that.
@@ -115,7 +118,15 @@ pub fn cut(src: &mut dyn Source, name: &str, line: &[LatLon], ds: f64) -> Result
     let win = Window { rows, cols, z };
     let mut depth = Vec::with_capacity(x.len());
     for (k, &(fr, fc)) in frac.iter().enumerate() {
-        let at_k = || format!("{} at x = {:.1} m (lat {:.6}, lon {:.6})", where_(&wp, k), x[k], at[k].lat, at[k].lon);
+        let at_k = || {
+            format!(
+                "{} at x = {:.1} m (lat {:.6}, lon {:.6})",
+                where_(&wp, k),
+                x[k],
+                at[k].lat,
+                at[k].lon
+            )
+        };
         let elev = win.bilinear(&g, fr, fc).map_err(|m| match m {
             Miss::Outside => leaves(k),
             Miss::Nodata => Fail::input(format!("{name}: {} meets nodata in the grid", at_k())),
@@ -129,7 +140,12 @@ pub fn cut(src: &mut dyn Source, name: &str, line: &[LatLon], ds: f64) -> Result
         depth.push(-elev);
     }
     let waypoints = wp.iter().map(|&k| (k, at[k])).collect();
-    Ok(Cut { x, depth, at, waypoints })
+    Ok(Cut {
+        x,
+        depth,
+        at,
+        waypoints,
+    })
 }
 
 impl Cut {
@@ -146,7 +162,10 @@ impl Cut {
     pub fn waypoints_csv(&self) -> String {
         let mut s = String::from("wp,x_m,lat,lon\n");
         for (i, (k, p)) in self.waypoints.iter().enumerate() {
-            s.push_str(&format!("{i},{:.3},{:.8},{:.8}\n", self.x[*k], p.lat, p.lon));
+            s.push_str(&format!(
+                "{i},{:.3},{:.8},{:.8}\n",
+                self.x[*k], p.lat, p.lon
+            ));
         }
         s
     }
@@ -183,15 +202,26 @@ impl Cut {
             waypoints.push((x.len() - 1, p[1]));
         }
         let depth = vec![f64::NAN; x.len()];
-        Self { x, depth, at, waypoints }
+        Self {
+            x,
+            depth,
+            at,
+            waypoints,
+        }
     }
 
     /// Position at along-track `x` (m), linear between samples.
     pub fn position(&self, x: f64) -> LatLon {
-        let k = self.x.partition_point(|&s| s <= x).clamp(1, self.x.len() - 1);
+        let k = self
+            .x
+            .partition_point(|&s| s <= x)
+            .clamp(1, self.x.len() - 1);
         let (x0, x1) = (self.x[k - 1], self.x[k]);
         let t = ((x - x0) / (x1 - x0)).clamp(0.0, 1.0);
         let (a, b) = (self.at[k - 1], self.at[k]);
-        LatLon { lat: a.lat + t * (b.lat - a.lat), lon: a.lon + t * (b.lon - a.lon) }
+        LatLon {
+            lat: a.lat + t * (b.lat - a.lat),
+            lon: a.lon + t * (b.lon - a.lon),
+        }
     }
 }

@@ -37,7 +37,9 @@ impl EsriAscii {
         let mut lines = text.lines().enumerate().peekable();
         // Header lines start with a letter; the data with a number.
         while let Some((n, line)) = lines.next_if(|(_, l)| {
-            l.trim().is_empty() || l.trim_start().starts_with(|c: char| c.is_ascii_alphabetic())
+            l.trim().is_empty()
+                || l.trim_start()
+                    .starts_with(|c: char| c.is_ascii_alphabetic())
         }) {
             let mut it = line.split_whitespace();
             let (Some(key), Some(v), None) = (it.next(), it.next(), it.next()) else {
@@ -92,6 +94,8 @@ impl EsriAscii {
                 let num: f64 = v.parse().map_err(|_| {
                     Fail::input(format!("{name}:{}: value '{v}' is not a number", n + 1))
                 })?;
+                // Nodata is an exact value of the file.
+                #[allow(clippy::float_cmp)]
                 let nodata = h.nodata.is_some_and(|nd| num == nd) || !num.is_finite();
                 z.push(if nodata { f32::NAN } else { num as f32 });
             }

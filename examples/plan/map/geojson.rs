@@ -73,7 +73,11 @@ pub fn plan(
         .iter()
         .map(|r| {
             let p = cut.position(f64::from(r.x));
-            json!([round(p.lon, 8), round(p.lat, 8), round(-f64::from(r.depth), 2)])
+            json!([
+                round(p.lon, 8),
+                round(p.lat, 8),
+                round(-f64::from(r.depth), 2)
+            ])
         })
         .collect();
     features.push(json!({

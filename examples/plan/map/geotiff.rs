@@ -50,7 +50,9 @@ impl GeoTiff {
         let tie = d
             .get_tag_f64_vec(Tag::ModelTiepointTag)
             .map_err(|e| fail("no ModelTiepoint tag (33922), so no georeferencing", &e))?;
-        let keys = d.get_tag_u16_vec(Tag::GeoKeyDirectoryTag).unwrap_or_default();
+        let keys = d
+            .get_tag_u16_vec(Tag::GeoKeyDirectoryTag)
+            .unwrap_or_default();
         let geokey = |id: u16| {
             keys.get(4..)
                 .unwrap_or(&[])
@@ -82,9 +84,14 @@ impl GeoTiff {
         };
         georef.validate(&name)?;
         let nodata = match d.get_tag_ascii_string(Tag::GdalNodata) {
-            Ok(s) => Some(s.trim_matches(char::from(0)).trim().parse::<f64>().map_err(|_| {
-                Fail::input(format!("{name}: GDAL_NODATA tag '{s}' is not a number"))
-            })?),
+            Ok(s) => Some(
+                s.trim_matches(char::from(0))
+                    .trim()
+                    .parse::<f64>()
+                    .map_err(|_| {
+                        Fail::input(format!("{name}: GDAL_NODATA tag '{s}' is not a number"))
+                    })?,
+            ),
             Err(_) => None,
         };
         Ok(Self {
@@ -125,10 +132,9 @@ impl Source for GeoTiff {
         for cr in rows.start / ch..=(rows.end - 1) / ch {
             for cc in cols.start / cw..=(cols.end - 1) / cw {
                 let index = cr * across + cc;
-                let chunk = self
-                    .decoder
-                    .read_chunk(index as u32)
-                    .map_err(|e| Fail::input(format!("{}: GeoTIFF chunk {index}: {e}", self.name)))?;
+                let chunk = self.decoder.read_chunk(index as u32).map_err(|e| {
+                    Fail::input(format!("{}: GeoTIFF chunk {index}: {e}", self.name))
+                })?;
                 let (dw, _) = self.decoder.chunk_data_dimensions(index as u32);
                 let v = values(chunk).ok_or_else(|| {
                     Fail::input(format!("{}: GeoTIFF sample type not supported", self.name))
@@ -137,7 +143,13 @@ impl Source for GeoTiff {
                 for (k, &z) in v.iter().enumerate() {
                     let (r, c) = (cr * ch + k / dw, cc * cw + k % dw);
                     if rows.contains(&r) && cols.contains(&c) {
-                        let nodata = self.nodata.is_some_and(|nd| z == nd) || !z.is_finite();
+                        // Nodata is an exact value of the file, in its
+                        // sample type (a float32 file's "-3.4028235e+38").
+                        #[allow(clippy::float_cmp)]
+                        let nodata = self
+                            .nodata
+                            .is_some_and(|nd| z == nd || z as f32 == nd as f32)
+                            || !z.is_finite();
                         out[(r - rows.start) * width + (c - cols.start)] =
                             if nodata { f32::NAN } else { z as f32 };
                     }

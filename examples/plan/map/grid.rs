@@ -95,7 +95,9 @@ impl Window {
             return None;
         }
         let w = self.cols.len();
-        self.z.get((r - self.rows.start) * w + (c - self.cols.start)).copied()
+        self.z
+            .get((r - self.rows.start) * w + (c - self.cols.start))
+            .copied()
     }
 
     /// Bilinear elevation at fractional (row, column) `(fr, fc)` of the
@@ -108,7 +110,10 @@ impl Window {
         }
         let r = (fr.max(0.0).floor() as usize).min(g.rows - 2);
         let c = (fc.max(0.0).floor() as usize).min(g.cols - 2);
-        let (t, u) = ((fr - r as f64).clamp(0.0, 1.0), (fc - c as f64).clamp(0.0, 1.0));
+        let (t, u) = (
+            (fr - r as f64).clamp(0.0, 1.0),
+            (fc - c as f64).clamp(0.0, 1.0),
+        );
         let mut z = [0.0f64; 4];
         for (k, (dr, dc)) in [(0, 0), (0, 1), (1, 0), (1, 1)].into_iter().enumerate() {
             let v = self.node(r + dr, c + dc).ok_or(Miss::Outside)?;

@@ -33,7 +33,9 @@ pub fn read(path: &Path) -> Result<Vec<LatLon>, Fail> {
         )));
     }
     for (i, w) in pts.windows(2).enumerate() {
-        if w[0].lat == w[1].lat && w[0].lon == w[1].lon {
+        #[allow(clippy::float_cmp)] // the very same point, not a near one
+        let same = w[0].lat == w[1].lat && w[0].lon == w[1].lon;
+        if same {
             return Err(Fail::input(format!(
                 "{name}: waypoints {i} and {} are the same point: a track must have a length",
                 i + 1
@@ -66,15 +68,16 @@ fn csv(text: &str, name: &str) -> Result<Vec<LatLon>, Fail> {
         .split(',')
         .map(str::trim)
         .collect();
-    let col = |c: &str| {
-        header.iter().position(|h| h.eq_ignore_ascii_case(c)).ok_or_else(|| {
+    let col =
+        |c: &str| {
+            header.iter().position(|h| h.eq_ignore_ascii_case(c)).ok_or_else(|| {
             Fail::input(format!(
                 "{name}:{}: a line's header must name column '{c}' (expected wp,lat,lon, WGS84 \
                  degrees, or a GeoJSON LineString)",
                 hn + 1
             ))
         })
-    };
+        };
     let (ilat, ilon) = (col("lat")?, col("lon")?);
     let mut out = Vec::new();
     for (n, line) in lines {
@@ -91,9 +94,20 @@ fn csv(text: &str, name: &str) -> Result<Vec<LatLon>, Fail> {
             f[i].parse::<f64>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| Fail::input(format!("{name}:{}: {c} '{}' is not a finite number", n + 1, f[i])))
+                .ok_or_else(|| {
+                    Fail::input(format!(
+                        "{name}:{}: {c} '{}' is not a finite number",
+                        n + 1,
+                        f[i]
+                    ))
+                })
         };
-        out.push(check(name, &(n + 1).to_string(), num(ilat, "lat")?, num(ilon, "lon")?)?);
+        out.push(check(
+            name,
+            &(n + 1).to_string(),
+            num(ilat, "lat")?,
+            num(ilon, "lon")?,
+        )?);
     }
     Ok(out)
 }
@@ -104,7 +118,9 @@ fn geojson(text: &str, name: &str) -> Result<Vec<LatLon>, Fail> {
     let bad = |what: &str| Fail::input(format!("{name}: {what}"));
     let geometry = match v.get("type").and_then(Value::as_str) {
         Some("LineString") => &v,
-        Some("Feature") => v.get("geometry").ok_or_else(|| bad("a Feature without geometry"))?,
+        Some("Feature") => v
+            .get("geometry")
+            .ok_or_else(|| bad("a Feature without geometry"))?,
         Some("FeatureCollection") => {
             let lines: Vec<&Value> = v
                 .get("features")
@@ -126,7 +142,11 @@ fn geojson(text: &str, name: &str) -> Result<Vec<LatLon>, Fail> {
                 }
             }
         }
-        _ => return Err(bad("GeoJSON must be a LineString, or a Feature or FeatureCollection of one")),
+        _ => {
+            return Err(bad(
+                "GeoJSON must be a LineString, or a Feature or FeatureCollection of one",
+            ));
+        }
     };
     if geometry.get("type").and_then(Value::as_str) != Some("LineString") {
         return Err(bad("the geometry is not a LineString"));

@@ -56,7 +56,11 @@ pub fn parse_spacing(v: &str) -> Result<f64, Fail> {
         .parse::<f64>()
         .ok()
         .filter(|d| d.is_finite() && *d > 0.0)
-        .ok_or_else(|| Fail::usage(format!("--spacing must be a positive distance in m, got '{v}'")))
+        .ok_or_else(|| {
+            Fail::usage(format!(
+                "--spacing must be a positive distance in m, got '{v}'"
+            ))
+        })
 }
 
 /// `plan profile --help`.
@@ -106,7 +110,9 @@ pub fn profile_command(args: impl Iterator<Item = OsString>) -> Result<(), Fail>
             .find(|(f, _)| *f == flag)
             .ok_or_else(|| Fail::usage(format!("plan profile: unknown argument '{arg}'")))?;
         if slot.1.is_some() {
-            return Err(Fail::usage(format!("plan profile: {flag} given more than once")));
+            return Err(Fail::usage(format!(
+                "plan profile: {flag} given more than once"
+            )));
         }
         let v = inline
             .or_else(|| it.next())
@@ -115,7 +121,11 @@ pub fn profile_command(args: impl Iterator<Item = OsString>) -> Result<(), Fail>
     }
     let [grid, line, spacing, out_p, out_w] = opts.map(|(f, v)| (f, v));
     let need = |(f, v): (&str, Option<String>)| {
-        v.ok_or_else(|| Fail::usage(format!("plan profile: {f} is required (see plan profile --help)")))
+        v.ok_or_else(|| {
+            Fail::usage(format!(
+                "plan profile: {f} is required (see plan profile --help)"
+            ))
+        })
     };
     let spacing = spacing.1.as_deref().map(parse_spacing).transpose()?;
     let (grid, line) = (PathBuf::from(need(grid)?), PathBuf::from(need(line)?));

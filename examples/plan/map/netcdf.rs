@@ -63,9 +63,11 @@ impl NetCdf {
                     d.len() == 2 && is(&d[0], &LAT) && is(&d[1], &LON)
                 })
                 .ok_or_else(|| {
-                    fail("no 2-D variable over (lat, lon) dimensions (named lat/latitude/y and \
+                    fail(
+                        "no 2-D variable over (lat, lon) dimensions (named lat/latitude/y and \
                           lon/longitude/x)"
-                        .into())
+                            .into(),
+                    )
                 })?;
             let down = var
                 .get_attr_as_string("positive")
@@ -84,7 +86,9 @@ impl NetCdf {
                 .read_var(d)
                 .map_err(|e| fail(format!("no coordinate variable '{d}': {e:?}")))?;
             regular(&floats(v)).ok_or_else(|| {
-                fail(format!("coordinate '{d}' is not evenly spaced (a regular grid is needed)"))
+                fail(format!(
+                    "coordinate '{d}' is not evenly spaced (a regular grid is needed)"
+                ))
             })
         };
         let (lat0, dlat, rows) = coord(&mut f, &dims[0])?;
@@ -93,7 +97,14 @@ impl NetCdf {
             f.read_var(&var_name)
                 .map_err(|e| fail(format!("cannot read '{var_name}': {e:?}")))?,
         );
-        let mut georef = Georef { cols, rows, lon0, lat0, dlon, dlat };
+        let mut georef = Georef {
+            cols,
+            rows,
+            lon0,
+            lat0,
+            dlon,
+            dlat,
+        };
         let mut flip = false;
         if georef.dlon < 0.0 {
             // East to west columns: read them west to east.
@@ -103,8 +114,18 @@ impl NetCdf {
         }
         georef.validate(&name)?;
         for v in &mut z {
-            let nodata = fill.iter().flatten().any(|f| *v == *f) || !v.is_finite();
-            *v = if nodata { f64::NAN } else { (*v * scale + offset) * if down { -1.0 } else { 1.0 } };
+            // Fill values are exact values of the file, in its type.
+            #[allow(clippy::float_cmp)]
+            let nodata = fill
+                .iter()
+                .flatten()
+                .any(|f| *v == *f || *v as f32 == *f as f32)
+                || !v.is_finite();
+            *v = if nodata {
+                f64::NAN
+            } else {
+                (*v * scale + offset) * if down { -1.0 } else { 1.0 }
+            };
         }
         let mut z: Vec<f32> = z.into_iter().map(|v| v as f32).collect();
         if flip {
