@@ -22,7 +22,7 @@ use crate::report::{Report, TrajRow, num};
 
 /// At most this many trajectory positions (the flight is sampled every
 /// `U0·Ts`; a few thousand points draw it on any chart).
-const MAX_POINTS: usize = 2000;
+const MAX_POINTS: usize = 1000;
 
 fn round(v: f64, digits: i32) -> Value {
     let p = 10f64.powi(digits);
@@ -99,8 +99,16 @@ pub fn plan(
     json!({"type": "FeatureCollection", "features": features})
 }
 
-/// Writes the plan's GeoJSON to `path`.
+/// Writes the plan's GeoJSON to `path`, one feature a line.
 pub fn write(path: &Path, v: &Value) -> Result<(), Fail> {
-    std::fs::write(path, format!("{v:#}\n"))
+    let features: Vec<String> = v["features"]
+        .as_array()
+        .map(|f| f.iter().map(Value::to_string).collect())
+        .unwrap_or_default();
+    let text = format!(
+        "{{\"type\": \"FeatureCollection\", \"features\": [\n{}\n]}}\n",
+        features.join(",\n")
+    );
+    std::fs::write(path, text)
         .map_err(|e| Fail::input(format!("{}: cannot write: {e}", path.display())))
 }
