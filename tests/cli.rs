@@ -982,3 +982,27 @@ fn plot_title_below_h_a_and_legend() {
         "reference depth legend is not dashed ({segments} segment)"
     );
 }
+
+/// Progress on stderr for runs longer than a second: with
+/// `PLAN_PROGRESS=1` (stderr here is a pipe, where it is off by default).
+#[test]
+fn progress_on_stderr_for_long_runs() {
+    let t = std::time::Instant::now();
+    let out = Command::new(tool())
+        .env("PLAN_PROGRESS", "1")
+        .output()
+        .unwrap();
+    let long = t.elapsed().as_secs_f64() > 2.0;
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    if long {
+        assert!(err.contains("plan: planning track 5 of 5,"), "{err:?}");
+    }
+    assert!(err.lines().all(|l| l.starts_with("plan: planning track")), "{err:?}");
+    let quiet = Command::new(tool())
+        .env("PLAN_PROGRESS", "0")
+        .args(["--depths", "990,900,700,400,250"])
+        .output()
+        .unwrap();
+    assert!(quiet.stderr.is_empty());
+}

@@ -12,6 +12,7 @@ mod fail;
 mod input;
 mod map;
 mod plot;
+mod progress;
 mod report;
 
 use std::process::ExitCode;
@@ -433,7 +434,9 @@ fn plan_line(
     let tracks = scenario.waypoints().tracks();
     let mut depths = Vec::with_capacity(tracks);
     let mut optimizer = Vec::with_capacity(tracks);
+    let progress = progress::Progress::new("plan");
     for n in 0..tracks {
+        progress.step("planning track", n + 1, tracks);
         let p = match planner.plan(scenario, &state, n) {
             Ok(p) => p,
             // An infeasible line may fly into the rock before the end: the
