@@ -998,7 +998,10 @@ fn progress_on_stderr_for_long_runs() {
     if long {
         assert!(err.contains("plan: planning track 5 of 5,"), "{err:?}");
     }
-    assert!(err.lines().all(|l| l.starts_with("plan: planning track")), "{err:?}");
+    assert!(
+        err.lines().all(|l| l.starts_with("plan: planning track")),
+        "{err:?}"
+    );
     let quiet = Command::new(tool())
         .env("PLAN_PROGRESS", "0")
         .args(["--depths", "990,900,700,400,250"])

@@ -635,3 +635,25 @@ fn geojson_needs_positions() {
         &["--geojson needs the waypoints' lat/lon"],
     );
 }
+
+/// Longitudes given in 0..360 are the same places on a −180..180 grid.
+#[test]
+fn longitudes_wrap() {
+    let line = columns(&fixture("lines/monterey_1.csv"));
+    let mut text = String::from("wp,lat,lon\n");
+    for (i, (lat, lon)) in line[1].iter().zip(&line[2]).enumerate() {
+        text += &format!("{i},{lat},{}\n", lon + 360.0);
+    }
+    let east = tmp_dir().join("east.csv");
+    std::fs::write(&east, text).unwrap();
+    let (p, _) = profile(
+        &fixture("grids/monterey_gebco.asc"),
+        east.to_str().unwrap(),
+        &[],
+    );
+    let g = columns(&fixture("grids/golden/monterey_1.csv"));
+    assert_eq!(p[1].len(), g[1].len());
+    for (b, gb) in p[1].iter().zip(&g[1]) {
+        assert!((b - gb).abs() <= 0.5, "{b} vs {gb}");
+    }
+}
