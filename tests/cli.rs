@@ -796,6 +796,8 @@ fn help_lists_the_whole_interface() {
             "--geojson",
             "plan profile",
             "a quarter",
+            "uncertainty (the six",
+            "PLAN_PROGRESS",
             "horizon (default)",
             "bfgs (default",
             "us_monterey_canyon_1",

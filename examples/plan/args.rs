@@ -140,7 +140,9 @@ Output: a table (with a header naming the profile, the vehicle, h_r and h_a)
 or, with --json, one object: method, mode, tracks[] (track, x_start, x_end,
 depth, J, rms, min_altitude, safe, iterations, evaluations, status, J_history),
 total_J, min_altitude (least flown), safe, profile, reference_altitude,
-min_altitude_limit (h_a), vehicle.
+min_altitude_limit (h_a), vehicle, uncertainty (the six declared keys above).
+Progress (one line per track) goes to stderr once a run takes over a second,
+when stderr is a terminal or PLAN_PROGRESS=1 (PLAN_PROGRESS=0: never).
 
 Exit status: 0 on success (also for a plan that cannot be made safe: it is
 reported safe = false); 2 for bad input, with one line on stderr naming the
