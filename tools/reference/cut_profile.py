@@ -97,8 +97,11 @@ def cut(nodes, pts):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--data", default=os.path.join(ROOT, "..", "shared", "data", "bathymetry"))
+    ap.add_argument("--check", action="store_true",
+                    help="verify the committed goldens reproduce, write nothing")
     a = ap.parse_args()
     os.makedirs(GOLDEN, exist_ok=True)
+    differ = []
     d120, d240 = 1.0 / 120.0, 1.0 / 240.0
     cases = {
         "monterey_1": (monterey(a.data), "monterey_1"),
@@ -109,15 +112,24 @@ def main():
     }
     for case, (nodes, line) in cases.items():
         prof, wx = cut(nodes, read_line(line))
-        with open(os.path.join(GOLDEN, case + ".csv"), "w") as f:
-            f.write("x_m,bottom_depth_m,lat,lon\n")
-            for x, b, la, lo in prof:
-                f.write(f"{x:.4f},{b:.4f},{la:.9f},{lo:.9f}\n")
-        with open(os.path.join(GOLDEN, case + ".waypoints.csv"), "w") as f:
-            f.write("wp,x_m\n")
-            for i, x in enumerate(wx):
-                f.write(f"{i},{x:.4f}\n")
+        texts = {
+            case + ".csv": "x_m,bottom_depth_m,lat,lon\n" + "".join(
+                f"{x:.4f},{b:.4f},{la:.9f},{lo:.9f}\n" for x, b, la, lo in prof),
+            case + ".waypoints.csv": "wp,x_m\n" + "".join(
+                f"{i},{x:.4f}\n" for i, x in enumerate(wx)),
+        }
+        for name, text in texts.items():
+            path = os.path.join(GOLDEN, name)
+            if a.check:
+                if not os.path.exists(path) or open(path).read() != text:
+                    differ.append(name)
+            else:
+                with open(path, "w") as f:
+                    f.write(text)
         print(f"{case}: {len(prof)} samples, {wx[-1]:.2f} m")
+    if a.check:
+        print("goldens reproduce" if not differ else f"DIFFER: {differ}")
+        raise SystemExit(1 if differ else 0)
 
 
 if __name__ == "__main__":
