@@ -31,8 +31,11 @@ struct Header {
 impl EsriAscii {
     pub fn open(path: &Path) -> Result<Self, Fail> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Fail::input(format!("{name}: cannot read as text: {e}")))?;
+        let text = std::fs::read_to_string(path).map_err(|e| {
+            Fail::input(format!(
+                "{name}: not a grid: neither GeoTIFF, NetCDF nor Esri ASCII text ({e})"
+            ))
+        })?;
         let mut h = Header::default();
         let mut lines = text.lines().enumerate().peekable();
         // Header lines start with a letter; the data with a number.
