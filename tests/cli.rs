@@ -452,7 +452,8 @@ fn plot_writes_an_svg_figure() {
         "bottom b(x)",
         "minimum-altitude envelope",
         "AUV flight",
-        "objective against iteration",
+        "J against iteration, per track",
+        "the line (lon, lat)",
     ] {
         assert!(svg.contains(label), "figure lacks {label}");
     }
@@ -789,6 +790,14 @@ fn help_lists_the_whole_interface() {
             "--json",
             "--trajectory",
             "--plot",
+            "--grid",
+            "--line",
+            "--spacing",
+            "--geojson",
+            "plan profile",
+            "a quarter",
+            "uncertainty (the six",
+            "PLAN_PROGRESS",
             "horizon (default)",
             "bfgs (default",
             "us_monterey_canyon_1",
@@ -855,4 +864,150 @@ fn outputs_name_profile_vehicle_and_altitudes() {
         text.lines().nth(1).unwrap(),
         "profile us_monterey_canyon_1 (bundled), vehicle C-AUV #4 (default), h_r 80 m, h_a 60 m"
     );
+}
+
+#[test]
+fn outputs_name_the_declared_uncertainty() {
+    let v = json_of(&["--depths", "990,900,700,400,250", "--json"]);
+    let u = v["uncertainty"].as_object().unwrap();
+    for k in [
+        "horizontal_uncertainty",
+        "nav_drift",
+        "vertical_uncertainty",
+        "speed_uncertainty",
+        "flight_path_offset",
+        "vertical_current",
+    ] {
+        assert_eq!(u[k], 0.0, "{k}");
+    }
+    let text = String::from_utf8(run(&["--depths", "990,900,700,400,250"]).stdout).unwrap();
+    assert!(
+        text.lines()
+            .nth(2)
+            .unwrap()
+            .starts_with("declared uncertainty: none"),
+        "{text}"
+    );
+    let a = with_config(
+        PROFILE,
+        "reference_altitude = 50.0\nmin_altitude = 30.0\nvertical_uncertainty = 2.5\nnav_drift = 0.002\n",
+        &["--depths", "50,50", "--json"],
+    );
+    let v = json_of(&refs(&a));
+    assert_eq!(v["uncertainty"]["vertical_uncertainty"], 2.5);
+    assert_eq!(v["uncertainty"]["nav_drift"], 0.002);
+    let a = with_config(
+        PROFILE,
+        "reference_altitude = 50.0\nmin_altitude = 30.0\nvertical_uncertainty = 2.5\n",
+        &["--depths", "50,50"],
+    );
+    let out = run(&refs(&a));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = text.lines().nth(2).unwrap();
+    assert!(line.contains("vertical_uncertainty 2.5 m"), "{line}");
+}
+
+/// The plot's title names the profile by its file stem, not the whole
+/// path; the stretches below h_a are shaded and labelled; no map inset
+/// when the waypoints have no lat/lon; the reference-depth legend is
+/// dashed as the lines are (drawn as several short segments).
+#[test]
+fn plot_title_below_h_a_and_legend() {
+    let dir = std::env::temp_dir().join(format!("auvnav-plot2-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("g.svg");
+    // 100 m deep over a bottom at 90-110 m with h_a = 60: below h_a.
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--depths", "40,40", "--plot", out.to_str().unwrap()],
+    );
+    let o = run(&refs(&a));
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let svg = std::fs::read_to_string(&out).unwrap();
+    let stem = Path::new(&a[1]).file_stem().unwrap().to_str().unwrap();
+    let tmpdir = Path::new(&a[1]).parent().unwrap().to_str().unwrap();
+    assert!(
+        svg.contains(&format!("{stem} — fixed")),
+        "title lacks the stem {stem}"
+    );
+    assert!(!svg.contains(tmpdir), "title holds the whole path");
+    assert!(
+        svg.contains("below h_a (1 stretch"),
+        "below-h_a stretches not marked"
+    );
+    assert!(
+        !svg.contains("the line (lon, lat)"),
+        "inset without lat/lon"
+    );
+    // A run above h_a everywhere marks nothing.
+    let a = with(
+        PROFILE,
+        WAYPOINTS,
+        &["--depths", "20,20", "--plot", out.to_str().unwrap()],
+    );
+    assert_eq!(run(&refs(&a)).status.code(), Some(0));
+    let svg = std::fs::read_to_string(&out).unwrap();
+    assert!(
+        !svg.contains("below h_a ("),
+        "marked though never below h_a"
+    );
+    // The legend's sample of the reference depth (grey, left of its
+    // label): dashed as the lines are, so several short segments.
+    let at = svg.find("reference depth z_n").unwrap();
+    let open = svg[..at].rfind("<text").unwrap();
+    let attr = |tag: &str, key: &str| -> f64 {
+        let i = tag.find(&format!(" {key}=\"")).unwrap() + key.len() + 3;
+        tag[i..i + tag[i..].find('"').unwrap()].parse().unwrap()
+    };
+    let (label_x, label_y) = (attr(&svg[open..at], "x"), attr(&svg[open..at], "y"));
+    let segments = svg
+        .split("<polyline")
+        .filter(|p| p.contains("stroke=\"#5A5A5A\""))
+        .filter(|p| {
+            let pts = &p[p.find("points=\"").unwrap() + 8..];
+            let pts = &pts[..pts.find('"').unwrap()];
+            pts.split_whitespace().all(|xy| {
+                let (x, y) = xy.split_once(',').unwrap();
+                let (x, y): (f64, f64) = (x.parse().unwrap(), y.parse().unwrap());
+                x < label_x && (y - label_y).abs() < 12.0
+            })
+        })
+        .count();
+    assert!(
+        segments >= 2,
+        "reference depth legend is not dashed ({segments} segment)"
+    );
+}
+
+/// Progress on stderr for runs longer than a second: with
+/// `PLAN_PROGRESS=1` (stderr here is a pipe, where it is off by default).
+#[test]
+fn progress_on_stderr_for_long_runs() {
+    let t = std::time::Instant::now();
+    let out = Command::new(tool())
+        .env("PLAN_PROGRESS", "1")
+        .output()
+        .unwrap();
+    let long = t.elapsed().as_secs_f64() > 2.0;
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(out.status.code(), Some(0));
+    if long {
+        assert!(err.contains("plan: planning track 5 of 5,"), "{err:?}");
+    }
+    assert!(
+        err.lines().all(|l| l.starts_with("plan: planning track")),
+        "{err:?}"
+    );
+    let quiet = Command::new(tool())
+        .env("PLAN_PROGRESS", "0")
+        .args(["--depths", "990,900,700,400,250"])
+        .output()
+        .unwrap();
+    assert!(quiet.stderr.is_empty());
 }

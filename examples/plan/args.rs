@@ -35,13 +35,24 @@ pub struct Args {
     pub json: bool,
     pub trajectory: Option<PathBuf>,
     pub plot: Option<PathBuf>,
+    /// `--grid GRID --line LINE`: the profile cut from a map.
+    pub grid: Option<PathBuf>,
+    pub line: Option<PathBuf>,
+    /// `--spacing DS` (m) of the cut, with `--grid`.
+    pub spacing: Option<f64>,
+    /// `--geojson OUT.geojson`: the plan on the chart.
+    pub geojson: Option<PathBuf>,
 }
 
 /// `plan --help`: the whole interface of spec/cli.md with every default.
 pub const USAGE: &str = "\
-usage: plan [--profile PROFILE.csv --waypoints WAYPOINTS.csv] [--config VEHICLE.toml]
+usage: plan [--profile PROFILE.csv --waypoints WAYPOINTS.csv | --grid GRID --line LINE
+             [--spacing DS]] [--config VEHICLE.toml]
             [--depths z1,...,zM] [--method bfgs|gd] [--mode horizon|track] [--horizon K]
             [--unconstrained] [--json] [--trajectory OUT.csv] [--plot OUT.svg]
+            [--geojson OUT.geojson]
+       plan profile --grid GRID --line LINE [--spacing DS] --out-profile P.csv
+                    --out-waypoints W.csv      (plan profile --help for details)
 
 Plans the reference depth of each track of a survey line over a bottom profile
 (or, with --depths, evaluates given depths). With no --profile/--waypoints it
@@ -54,6 +65,14 @@ Options (each at most once; --flag VALUE or --flag=VALUE):
   --waypoints WAYPOINTS.csv  header wp,x_m (more columns allowed, ignored); waypoint 0
                              starts the line, M = waypoints - 1 tracks; every
                              waypoint within the profile. Goes with --profile.
+  --grid GRID                bathymetry grid, elevation positive up, WGS84 lat/lon:
+                             GeoTIFF, Esri ASCII or classic NetCDF. Goes with --line;
+                             replaces --profile/--waypoints (the profile is cut as
+                             by plan profile)
+  --line LINE                survey line: CSV wp,lat,lon (WGS84 degrees) or a GeoJSON
+                             LineString. Goes with --grid.
+  --spacing DS               largest sample spacing of the cut, m (default: a quarter
+                             of the grid cell). Only with --grid.
   --config VEHICLE.toml      vehicle and mission settings (keys below); default:
                              the C-AUV #4 of model.md section 9
   --depths z1,...,zM         evaluate exactly these reference depths (m, one per
@@ -72,6 +91,13 @@ Options (each at most once; --flag VALUE or --flag=VALUE):
                              target_m,pitch_deg,elevator_deg,reference_m
   --plot OUT.svg             draw the flight, the h_r and h_a envelopes, the waypoints
                              and J against iteration
+  --geojson OUT.geojson      write the plan as RFC 7946 GeoJSON ([lon, lat]): a Point
+                             per waypoint (wp, x_m, bottom_depth_m, track,
+                             reference_depth_m, predicted_min_altitude_m,
+                             certified_min_altitude_m, safe, status) and the flown
+                             trajectory as a LineString [lon, lat, -depth] (depth_m,
+                             x_m). Needs lat/lon: --grid/--line, or --waypoints
+                             with lat,lon columns.
   -h, --help                 print this help
 
 VEHICLE.toml (every key optional, default shown; an unknown key is an error):
@@ -114,7 +140,9 @@ Output: a table (with a header naming the profile, the vehicle, h_r and h_a)
 or, with --json, one object: method, mode, tracks[] (track, x_start, x_end,
 depth, J, rms, min_altitude, safe, iterations, evaluations, status, J_history),
 total_J, min_altitude (least flown), safe, profile, reference_altitude,
-min_altitude_limit (h_a), vehicle.
+min_altitude_limit (h_a), vehicle, uncertainty (the six declared keys above).
+Progress (one line per track) goes to stderr once a run takes over a second,
+when stderr is a terminal or PLAN_PROGRESS=1 (PLAN_PROGRESS=0: never).
 
 Exit status: 0 on success (also for a plan that cannot be made safe: it is
 reported safe = false); 2 for bad input, with one line on stderr naming the
@@ -154,6 +182,10 @@ impl Args {
             json: false,
             trajectory: None,
             plot: None,
+            grid: None,
+            line: None,
+            spacing: None,
+            geojson: None,
         };
         // Every option at most once: a second `--profile` would silently
         // replace the first.
@@ -182,6 +214,10 @@ impl Args {
                 "--depths" => a.depths = Some(value("--depths")?),
                 "--trajectory" => a.trajectory = Some(value("--trajectory")?.into()),
                 "--plot" => a.plot = Some(value("--plot")?.into()),
+                "--grid" => a.grid = Some(value("--grid")?.into()),
+                "--line" => a.line = Some(value("--line")?.into()),
+                "--geojson" => a.geojson = Some(value("--geojson")?.into()),
+                "--spacing" => a.spacing = Some(crate::map::parse_spacing(&value("--spacing")?)?),
                 "--method" => {
                     a.method = match value("--method")?.as_str() {
                         "bfgs" => Method::Bfgs,
@@ -242,6 +278,7 @@ impl Args {
                 "--horizon applies to --mode horizon only, not to --mode track".into(),
             ));
         }
+        a.check_map()?;
         if a.profile.is_some() != a.waypoints.is_some() {
             return Err(Fail::usage(
                 "--profile and --waypoints go together (give both, or neither for the bundled line)"
@@ -249,6 +286,29 @@ impl Args {
             ));
         }
         Ok(a)
+    }
+}
+
+impl Args {
+    /// `--grid` with `--line`, instead of `--profile`/`--waypoints`;
+    /// `--spacing` only with `--grid`.
+    fn check_map(&self) -> Result<(), Fail> {
+        if self.grid.is_some() != self.line.is_some() {
+            return Err(Fail::usage(
+                "--grid and --line go together (the line is cut from the grid)".into(),
+            ));
+        }
+        if self.grid.is_some() && (self.profile.is_some() || self.waypoints.is_some()) {
+            return Err(Fail::usage(
+                "--grid/--line replace --profile/--waypoints: give one pair, not both".into(),
+            ));
+        }
+        if self.spacing.is_some() && self.grid.is_none() {
+            return Err(Fail::usage(
+                "--spacing sets the cut of --grid/--line; it does not apply to --profile".into(),
+            ));
+        }
+        Ok(())
     }
 }
 

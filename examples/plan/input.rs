@@ -104,7 +104,19 @@ pub fn profile(text: &str, name: &str) -> Result<(Vec<f32>, Vec<f32>), Fail> {
 
 /// Waypoints CSV (`wp,x_m`, more columns ignored): positions.
 pub fn waypoints(text: &str, name: &str) -> Result<Vec<f32>, Fail> {
-    let rows = csv(text, name, &["x_m"])?;
+    let rows = csv(text, name, &["x_m"]).map_err(|e| {
+        // A survey line in lat/lon only: say how to plan it.
+        let header = text.lines().find(|l| !l.trim().is_empty()).unwrap_or("");
+        let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+        if cols.contains(&"lat") && cols.contains(&"lon") && !cols.contains(&"x_m") {
+            Fail::input(format!(
+                "{name}: waypoints in lat,lon without x_m: cut the profile under the line from a \
+                 map with --grid GRID --line {name} (or plan profile --grid GRID --line {name})"
+            ))
+        } else {
+            e
+        }
+    })?;
     if rows.len() < 2 {
         return Err(Fail::input(format!(
             "{name}: need at least 2 waypoints (one track), found {}",
@@ -113,6 +125,26 @@ pub fn waypoints(text: &str, name: &str) -> Result<Vec<f32>, Fail> {
     }
     increasing(&rows, name, "x_m")?;
     Ok(rows.iter().map(|r| r.1[0]).collect())
+}
+
+/// The positions of the waypoints of a CSV with `lat,lon` columns (for
+/// `--geojson` over a `--profile`), or an error saying how to get them.
+pub fn waypoint_positions(text: &str, name: &str, wx: &[f32]) -> Result<crate::map::Cut, Fail> {
+    let rows = csv(text, name, &["lat", "lon"]).map_err(|_| {
+        Fail::usage(format!(
+            "--geojson needs the waypoints' lat/lon: {name} has no lat,lon columns; give \
+             --grid GRID --line LINE, or waypoints with lat,lon columns"
+        ))
+    })?;
+    let pts: Vec<crate::map::line::LatLon> = rows
+        .iter()
+        .map(|r| crate::map::line::LatLon {
+            lat: f64::from(r.1[0]),
+            lon: f64::from(r.1[1]),
+        })
+        .collect();
+    let wx: Vec<f64> = wx.iter().map(|&x| f64::from(x)).collect();
+    Ok(crate::map::Cut::from_waypoints(&wx, &pts))
 }
 
 /// Checks that the first column strictly increases, naming the file line.

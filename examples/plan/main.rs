@@ -10,7 +10,9 @@
 mod args;
 mod fail;
 mod input;
+mod map;
 mod plot;
+mod progress;
 mod report;
 
 use std::process::ExitCode;
@@ -30,7 +32,16 @@ const ENVELOPE: usize = 3 * SAMPLES + 1;
 use report::{Report, TrackReport, TrajRow};
 
 fn main() -> ExitCode {
-    match run(Args::parse_os(std::env::args_os().skip(1))) {
+    // Subcommands by their first argument; anything else is the planner.
+    let mut argv = std::env::args_os().skip(1).peekable();
+    let result = match argv.peek().and_then(|a| a.to_str()) {
+        Some("profile") => {
+            argv.next();
+            map::profile_command(argv)
+        }
+        _ => run(Args::parse_os(argv)),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Fail::Help) => {
             println!("{}", args::USAGE);
@@ -46,28 +57,22 @@ fn main() -> ExitCode {
 fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let args = args?;
     // What the report calls the profile and the vehicle.
-    let profile_label = args.profile.as_ref().map_or_else(
-        || "us_monterey_canyon_1 (bundled)".to_string(),
-        |p| p.display().to_string(),
-    );
+    let profile_label = match (&args.profile, &args.grid, &args.line) {
+        (Some(p), _, _) => p.display().to_string(),
+        (_, Some(g), Some(l)) => format!("{} on {}", l.display(), g.display()),
+        _ => "us_monterey_canyon_1 (bundled)".to_string(),
+    };
     let vehicle_label = args.config.as_ref().map_or_else(
         || "C-AUV #4 (default)".to_string(),
         |p| p.display().to_string(),
     );
-    let (profile_text, profile_name, wp_text, wp_name) = match (&args.profile, &args.waypoints) {
-        (Some(p), Some(w)) => (
-            input::read(p)?,
-            p.display().to_string(),
-            input::read(w)?,
-            w.display().to_string(),
-        ),
-        _ => (
-            input::BUNDLED_PROFILE.to_string(),
-            "us_monterey_canyon_1.csv (bundled)".to_string(),
-            input::BUNDLED_WAYPOINTS.to_string(),
-            "us_monterey_canyon_1.waypoints.csv (bundled)".to_string(),
-        ),
-    };
+    let LineInput {
+        profile_text,
+        profile_name,
+        wp_text,
+        wp_name,
+        mut cut,
+    } = line_input(&args, &profile_label)?;
     let config_text = match &args.config {
         Some(p) => Some((input::read(p)?, p.display().to_string())),
         None => None,
@@ -79,6 +84,15 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let profile = Profile::<SAMPLES>::new(&px, &pb)
         .map_err(|e| Fail::input(format!("{profile_name}: {e}")))?;
     let wx = input::waypoints(&wp_text, &wp_name)?;
+    if (args.geojson.is_some() || args.plot.is_some()) && cut.is_none() {
+        // The line on the map from waypoints with lat,lon columns: needed
+        // by --geojson, a map inset for --plot.
+        match input::waypoint_positions(&wp_text, &wp_name, &wx) {
+            Ok(c) => cut = Some(c),
+            Err(e) if args.geojson.is_some() => return Err(e),
+            Err(_) => {}
+        }
+    }
     let waypoints =
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
     let vehicle = Vehicle::new(&cfg.vehicle, cfg.plant)
@@ -151,7 +165,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let start = scenario.start_state(initial_depth);
     let mut scores = vec![TrackScore::default(); tracks];
     let mut rows = Vec::new();
-    let record = args.trajectory.is_some() || args.plot.is_some();
+    let record = args.trajectory.is_some() || args.plot.is_some() || args.geojson.is_some();
     let h_r = cfg.mission.reference_altitude();
     scenario
         .simulate(&start, 0, &report_base.depths, &mut scores, |s| {
@@ -181,6 +195,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         min_altitude_limit: h_a,
         method: report_base.method,
         mode: report_base.mode,
+        uncertainty: cfg.uncertainty,
         tracks: scores
             .iter()
             .zip(&report_base.depths)
@@ -216,8 +231,8 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
             path,
             &plot::Figure {
                 title: format!(
-                    "{} — {} / {}, total J {:.4e} m³, min altitude {:.2} m",
-                    profile_name,
+                    "{} — {} / {}, total J {:.3e} m³, min altitude {:.1} m",
+                    short_name(&report.profile),
                     report.method,
                     report.mode,
                     report.total_j(),
@@ -230,8 +245,19 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
                 min_altitude: h_a,
                 rows: &rows,
                 report: &report,
+                map: cut.as_ref().map(|c| {
+                    let ll = |p: &map::line::LatLon| (p.lon, p.lat);
+                    (
+                        c.at.iter().map(ll).collect(),
+                        c.waypoints.iter().map(|w| ll(&w.1)).collect(),
+                    )
+                }),
             },
         )?;
+    }
+    if let (Some(path), Some(c)) = (&args.geojson, &cut) {
+        let bottom = |x: f32| profile.depth_at(x).ok();
+        map::geojson::write(path, &map::geojson::plan(&report, c, &wx, &rows, &bottom))?;
     }
     if args.json {
         println!("{}", report.json());
@@ -239,6 +265,66 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         print!("{}", report.table());
     }
     Ok(())
+}
+
+/// The profile and waypoint texts a run plans over, with their names:
+/// cut from `--grid/--line` (and the cut, for the chart), read from
+/// `--profile/--waypoints`, or the bundled line. `label`: the report's
+/// name of the profile.
+struct LineInput {
+    profile_text: String,
+    profile_name: String,
+    wp_text: String,
+    wp_name: String,
+    cut: Option<map::Cut>,
+}
+
+fn line_input(args: &Args, label: &str) -> Result<LineInput, Fail> {
+    let mut cut = None;
+    let (profile_text, profile_name, wp_text, wp_name) = match (&args.profile, &args.waypoints) {
+        _ if args.grid.is_some() => {
+            let (g, l) = (args.grid.as_deref(), args.line.as_deref());
+            let (g, l) = g
+                .zip(l)
+                .ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
+            let (p, w, c) = map::profile_and_waypoints(g, l, args.spacing)?;
+            cut = Some(c);
+            (p, label.to_string(), w, l.display().to_string())
+        }
+        (Some(p), Some(w)) => (
+            input::read(p)?,
+            p.display().to_string(),
+            input::read(w)?,
+            w.display().to_string(),
+        ),
+        _ => (
+            input::BUNDLED_PROFILE.to_string(),
+            "us_monterey_canyon_1.csv (bundled)".to_string(),
+            input::BUNDLED_WAYPOINTS.to_string(),
+            "us_monterey_canyon_1.waypoints.csv (bundled)".to_string(),
+        ),
+    };
+    Ok(LineInput {
+        profile_text,
+        profile_name,
+        wp_text,
+        wp_name,
+        cut,
+    })
+}
+
+/// A profile's name for a title: the file stems, not the whole paths
+/// (`monterey_1 on monterey_gebco`, `us_monterey_canyon_1 (bundled)`).
+fn short_name(label: &str) -> String {
+    label
+        .split(" on ")
+        .map(|p| {
+            std::path::Path::new(p)
+                .file_stem()
+                .map_or_else(|| p.to_string(), |s| s.to_string_lossy().into_owned())
+        })
+        .collect::<Vec<_>>()
+        .join(" on ")
 }
 
 /// Inputs that are valid numbers but cannot describe a real flight
@@ -377,7 +463,9 @@ fn plan_line(
     let tracks = scenario.waypoints().tracks();
     let mut depths = Vec::with_capacity(tracks);
     let mut optimizer = Vec::with_capacity(tracks);
+    let progress = progress::Progress::new("plan");
     for n in 0..tracks {
+        progress.step("planning track", n + 1, tracks);
         let p = match planner.plan(scenario, &state, n) {
             Ok(p) => p,
             // An infeasible line may fly into the rock before the end: the

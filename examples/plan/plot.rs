@@ -5,6 +5,7 @@
 
 use std::path::Path;
 
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 use crate::fail::Fail;
@@ -20,7 +21,13 @@ pub struct Figure<'a> {
     pub min_altitude: f32,
     pub rows: &'a [TrajRow],
     pub report: &'a Report,
+    /// The line on the map, (lon, lat) of its samples and of its
+    /// waypoints, when known (`--grid/--line`, waypoints with lat/lon).
+    pub map: Option<MapLine>,
 }
+
+/// (lon, lat) of a line's samples and of its waypoints.
+pub type MapLine = (Vec<(f64, f64)>, Vec<(f64, f64)>);
 
 const TRACK_COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
@@ -125,7 +132,7 @@ fn draw_inner(path: &Path, fig: &Figure<'_>) -> Result<(), Box<dyn std::error::E
             "minimum-altitude envelope b − h_a (h_a = {} m)",
             fig.min_altitude
         ))
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], red));
+        .legend(move |(x, y)| DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 4, red));
     // Reference depths, one step per track.
     let grey = RGBColor(90, 90, 90);
     for (i, (t, w)) in fig
@@ -142,8 +149,9 @@ fn draw_inner(path: &Path, fig: &Figure<'_>) -> Result<(), Box<dyn std::error::E
             grey.stroke_width(1),
         ))?;
         if i == 0 {
-            s.label("reference depth z_n")
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+            s.label("reference depth z_n").legend(move |(x, y)| {
+                DashedPathElement::new(vec![(x, y), (x + 20, y)], 3, 3, grey)
+            });
         }
     }
     // Waypoints.
@@ -172,6 +180,7 @@ fn draw_inner(path: &Path, fig: &Figure<'_>) -> Result<(), Box<dyn std::error::E
         .draw_series(LineSeries::new(flight, blue.stroke_width(2)))?
         .label("AUV flight d(x)")
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], blue.stroke_width(2)));
+    below_min_altitude(&mut chart, fig, &in_line, (lo - pad, hi + pad))?;
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperLeft)
@@ -203,7 +212,7 @@ fn draw_inner(path: &Path, fig: &Figure<'_>) -> Result<(), Box<dyn std::error::E
             (1.0, 10.0)
         };
         let mut c = ChartBuilder::on(&bottom)
-            .caption("objective against iteration, per track (J plus the penalty when constrained; it steps up where a penalty stage raises μ)", ("sans-serif", 18))
+            .caption(history_caption(fig.report.mode), ("sans-serif", 18))
             .margin(15)
             .x_label_area_size(40)
             .y_label_area_size(70)
@@ -239,6 +248,124 @@ fn draw_inner(path: &Path, fig: &Figure<'_>) -> Result<(), Box<dyn std::error::E
             .border_style(BLACK.mix(0.3))
             .draw()?;
     }
+    if let Some((line, wps)) = &fig.map {
+        inset(&top, line, wps)?;
+    }
     root.present()?;
+    Ok(())
+}
+
+/// What the lower panel's curves are: the planner's objective at each
+/// iteration of each track's planning call.
+fn history_caption(mode: &str) -> &'static str {
+    if mode == "horizon" {
+        "J against iteration, per planning call: the horizon objective ΣJ (+ μΣV when constrained) over the tracks it optimizes"
+    } else {
+        "J against iteration, per track (+ μV, the penalty, when constrained)"
+    }
+}
+
+type Chart<'a, 'b> = ChartContext<
+    'a,
+    SVGBackend<'b>,
+    Cartesian2d<plotters::coord::types::RangedCoordf32, plotters::coord::types::RangedCoordf32>,
+>;
+
+/// Shades and marks the stretches where the flight is below `h_a` above
+/// the bottom.
+fn below_min_altitude(
+    chart: &mut Chart<'_, '_>,
+    fig: &Figure<'_>,
+    in_line: &dyn Fn(f32) -> bool,
+    (top, bottom): (f32, f32),
+) -> Result<(), Box<dyn std::error::Error>> {
+    let mut spans: Vec<(f32, f32)> = Vec::new();
+    let mut open: Option<f32> = None;
+    let mut last_x = 0.0;
+    for r in fig.rows.iter().filter(|r| in_line(r.x)) {
+        let below = r.bottom.is_some_and(|b| b - r.depth < fig.min_altitude);
+        match (below, open) {
+            (true, None) => open = Some(r.x),
+            (false, Some(x0)) => {
+                spans.push((x0, last_x));
+                open = None;
+            }
+            _ => {}
+        }
+        last_x = r.x;
+    }
+    if let Some(x0) = open {
+        spans.push((x0, last_x));
+    }
+    let orange = RGBColor(255, 140, 0);
+    for (i, &(x0, x1)) in spans.iter().enumerate() {
+        let s = chart.draw_series(std::iter::once(Rectangle::new(
+            [(x0, top), (x1.max(x0), bottom)],
+            orange.mix(0.25).filled(),
+        )))?;
+        if i == 0 {
+            s.label(format!(
+                "below h_a ({} stretch{})",
+                spans.len(),
+                if spans.len() == 1 { "" } else { "es" }
+            ))
+            .legend(move |(x, y)| {
+                Rectangle::new([(x, y - 5), (x + 20, y + 5)], orange.mix(0.5).filled())
+            });
+        }
+    }
+    Ok(())
+}
+
+/// A small map of the line (lon, lat), bottom right of the flight panel
+/// (over the seabed's fill more often than over the flight).
+fn inset(
+    area: &DrawingArea<SVGBackend<'_>, plotters::coord::Shift>,
+    line: &[(f64, f64)],
+    wps: &[(f64, f64)],
+) -> Result<(), Box<dyn std::error::Error>> {
+    let (w, h) = area.dim_in_pixel();
+    let sub = area
+        .clone()
+        .shrink(((w as i32) - 300, (h as i32) - 250), (270, 190));
+    sub.fill(&WHITE.mix(0.9))?;
+    let (lo0, lo1, la0, la1) = line.iter().fold(
+        (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ),
+        |(a, b, c, d), &(x, y)| (a.min(x), b.max(x), c.min(y), d.max(y)),
+    );
+    // Equal scales on the ground: a degree of longitude is cos(lat) of one
+    // of latitude.
+    let k = ((la0 + la1) / 2.0).to_radians().cos().max(0.05);
+    let half = ((lo1 - lo0) * k).max(la1 - la0).max(1e-4) * 0.6;
+    let (cx, cy) = ((lo0 + lo1) / 2.0, (la0 + la1) / 2.0);
+    let mut c = ChartBuilder::on(&sub)
+        .caption("the line (lon, lat)", ("sans-serif", 13))
+        .margin(4)
+        .x_label_area_size(18)
+        .y_label_area_size(48)
+        .build_cartesian_2d((cx - half / k)..(cx + half / k), (cy - half)..(cy + half))?;
+    c.configure_mesh()
+        .x_labels(3)
+        .y_labels(3)
+        .x_label_formatter(&|v| format!("{v:.3}"))
+        .y_label_formatter(&|v| format!("{v:.3}"))
+        .label_style(("sans-serif", 10))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()?;
+    c.draw_series(LineSeries::new(
+        line.iter().copied(),
+        RGBColor(20, 60, 200).stroke_width(2),
+    ))?;
+    c.draw_series(wps.iter().map(|&p| Circle::new(p, 3, BLACK.filled())))?;
+    c.draw_series(
+        wps.iter()
+            .enumerate()
+            .map(|(i, &p)| Text::new(format!("{i}"), p, ("sans-serif", 11))),
+    )?;
     Ok(())
 }

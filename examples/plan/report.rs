@@ -43,6 +43,36 @@ pub struct Report {
     pub method: &'static str,
     pub mode: &'static str,
     pub tracks: Vec<TrackReport>,
+    /// The declared uncertainty (model.md section 12), as the config keys.
+    pub uncertainty: crate::input::Uncertainty,
+}
+
+impl crate::input::Uncertainty {
+    /// The config keys, values and units.
+    pub fn keys(&self) -> [(&'static str, f32, &'static str); 6] {
+        [
+            ("horizontal_uncertainty", self.horizontal, " m"),
+            ("nav_drift", self.drift, " m/m"),
+            ("vertical_uncertainty", self.vertical, " m"),
+            ("speed_uncertainty", self.speed, ""),
+            ("flight_path_offset", self.flight_path_offset_deg, " deg"),
+            ("vertical_current", self.vertical_current, " m/s"),
+        ]
+    }
+
+    /// One line for the table's header.
+    pub fn describe(&self) -> String {
+        if self.keys().iter().all(|k| k.1 == 0.0) {
+            return "declared uncertainty: none (certified against the nominal model and map)"
+                .into();
+        }
+        let keys: Vec<String> = self
+            .keys()
+            .iter()
+            .map(|(k, v, u)| format!("{k} {v}{u}"))
+            .collect();
+        format!("declared uncertainty: {}", keys.join(", "))
+    }
 }
 
 impl Report {
@@ -102,19 +132,26 @@ impl Report {
             "reference_altitude": num(self.reference_altitude),
             "min_altitude_limit": num(self.min_altitude_limit),
             "vehicle": self.vehicle,
+            "uncertainty": self
+                .uncertainty
+                .keys()
+                .iter()
+                .map(|(k, v, _)| ((*k).to_string(), num(*v)))
+                .collect::<serde_json::Map<_, _>>(),
         })
     }
 
     /// The human-readable table.
     pub fn table(&self) -> String {
         let mut s = format!(
-            "method {}, mode {}\nprofile {}, vehicle {}, h_r {} m, h_a {} m\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>9} {:>5} {:>5} {:>5}  {:<12} {}\n",
+            "method {}, mode {}\nprofile {}, vehicle {}, h_r {} m, h_a {} m\n{}\n{:>5} {:>9} {:>9} {:>10} {:>14} {:>8} {:>9} {:>9} {:>5} {:>5} {:>5}  {:<12} {}\n",
             self.method,
             self.mode,
             self.profile,
             self.vehicle,
             self.reference_altitude,
             self.min_altitude_limit,
+            self.uncertainty.describe(),
             "track",
             "x_start",
             "x_end",
