@@ -171,3 +171,132 @@ impl Autopilot {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{AutopilotConfig, TransferFunction};
+
+    fn ap(depth_ki: f32) -> Autopilot {
+        let mut cfg = AutopilotConfig::default();
+        cfg.depth_pid.ki = depth_ki;
+        Autopilot::new(&cfg, &TransferFunction::C_AUV4, 0.1).unwrap()
+    }
+
+    fn input(reference: f32, depth: f32, pitch: f32, hold: bool) -> LoopInput {
+        LoopInput {
+            reference,
+            depth,
+            pitch,
+            pitch_rate: 0.3,
+            hold,
+        }
+    }
+
+    #[test]
+    fn engaged_step_is_update() {
+        let a = ap(0.0);
+        let mut st = LoopState::trimmed(50.0);
+        let mut plain = AutopilotState::trimmed(50.0);
+        for k in 0..50 {
+            let d = 50.0 + 0.05 * k as f32;
+            let out = a.step(&mut st, &input(60.0, d, -2.0, false));
+            let cmd = a.update(&mut plain, 60.0, d, -2.0, 0.3);
+            assert_eq!(out.command, Some(cmd));
+            assert_eq!(out.elevator.to_bits(), cmd.elevator.to_bits());
+            assert!(!out.held && !out.non_finite && !out.reengaged);
+        }
+        assert_eq!(st.cascade, plain);
+    }
+
+    #[test]
+    fn hold_keeps_the_command_and_freezes_the_integrators() {
+        let a = ap(0.05);
+        let mut st = LoopState::trimmed(50.0);
+        let last = a.step(&mut st, &input(52.0, 50.0, 0.0, false)).elevator;
+        let frozen = (st.cascade.depth_integral, st.cascade.pitch_integral);
+        for k in 0..30 {
+            let out = a.step(&mut st, &input(80.0, 50.0 + k as f32, 5.0, true));
+            assert!(out.held && !out.non_finite && out.command.is_none());
+            assert_eq!(out.elevator, last);
+            assert_eq!(st.cascade.depth_integral, frozen.0);
+            assert_eq!(st.cascade.pitch_integral, frozen.1);
+            assert_eq!(st.cascade.depth_prev, 50.0 + k as f32);
+        }
+    }
+
+    #[test]
+    fn non_finite_input_holds_and_flags() {
+        let a = ap(0.0);
+        let mut st = LoopState::trimmed(50.0);
+        let last = a.step(&mut st, &input(52.0, 50.0, 0.0, false)).elevator;
+        let cascade = st.cascade;
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            for which in 0..4 {
+                let mut i = input(52.0, 50.0, 0.0, false);
+                match which {
+                    0 => i.reference = bad,
+                    1 => i.depth = bad,
+                    2 => i.pitch = bad,
+                    _ => i.pitch_rate = bad,
+                }
+                let out = a.step(&mut st, &i);
+                assert!(out.held && out.non_finite, "{bad} at {which}");
+                assert_eq!(out.elevator, last);
+                assert_eq!(st.cascade, cascade);
+            }
+        }
+        // The next finite sample: a zero depth rate (the stale depth is
+        // replaced), bumpless, and finite.
+        let out = a.step(&mut st, &input(52.0, 53.0, 0.0, false));
+        assert!(out.reengaged && out.elevator.is_finite());
+        assert_eq!(out.command.map(|c| c.depth_terms.d), Some(0.0));
+        assert!(
+            (out.elevator - last).abs() < 1e-4,
+            "{} {last}",
+            out.elevator
+        );
+    }
+
+    #[test]
+    fn reengage_is_bumpless() {
+        // Without a depth integral only the pitch loop's integral can
+        // absorb the jump; with one, θref also starts at the measured pitch.
+        for depth_ki in [0.0, 0.05] {
+            let a = ap(depth_ki);
+            let mut st = LoopState::trimmed(50.0);
+            for _ in 0..20 {
+                a.step(&mut st, &input(55.0, 50.0, 0.0, false));
+            }
+            let held = st.elevator;
+            for _ in 0..20 {
+                a.step(&mut st, &input(70.0, 51.0, 3.0, true));
+            }
+            let out = a.step(&mut st, &input(70.0, 51.0, 3.0, false));
+            assert!(out.reengaged);
+            assert!(
+                (out.elevator - held).abs() < 1e-4,
+                "{} {held}",
+                out.elevator
+            );
+            if depth_ki > 0.0 {
+                let r = out.command.map_or(f32::NAN, |c| c.pitch_ref);
+                assert!((r - 3.0).abs() < 1e-4, "{r}");
+            }
+            // Without the bumpless step the command would jump.
+            let mut cold = AutopilotState::trimmed(51.0);
+            let jump = a.update(&mut cold, 70.0, 51.0, 3.0, 0.3).elevator;
+            assert!((jump - held).abs() > 1.0, "{jump} {held}");
+        }
+    }
+
+    #[test]
+    fn engage_continues_from_the_given_elevator() {
+        let a = ap(0.0);
+        let mut st = LoopState::engage(50.0, -7.0);
+        let out = a.step(&mut st, &input(50.0, 50.0, 0.0, false));
+        assert!(out.reengaged);
+        assert!((out.elevator + 7.0).abs() < 1e-4, "{}", out.elevator);
+        assert_eq!(LoopState::engage(50.0, f32::NAN).elevator, 0.0);
+    }
+}
