@@ -192,12 +192,12 @@ pub(crate) fn sort_total(v: &mut [f32]) {
     let n = v.len();
     let mut start = n / 2;
     while start > 0 {
-        start -= 1;
+        start = start.saturating_sub(1);
         sift_down(v, start, n);
     }
     let mut end = n;
     while end > 1 {
-        end -= 1;
+        end = end.saturating_sub(1);
         swap(v, 0, end);
         sift_down(v, 0, end);
     }
