@@ -30,6 +30,9 @@ src=crates/auvnav-c/tests/c
 inc=crates/auvnav-c/include
 mkdir -p "$out/json"
 
+say "C: the interface crate's unit tests"
+cargo test -p auvnav-c
+
 say "C: the static library, host (release) and Cortex-M4F (profile capi: fat LTO)"
 cargo build --release -p auvnav-c
 cargo build --profile capi -p auvnav-c --target thumbv7em-none-eabihf

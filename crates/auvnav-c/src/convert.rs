@@ -193,3 +193,31 @@ pub(crate) fn finite_vehicle(v: &auvnav_vehicle) -> Result<(), Code> {
         Err(AUVNAV_ERR_NON_FINITE)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_map_to_the_planner_config() {
+        let mut s = settings_default();
+        let pc = planner_config(&s).unwrap();
+        assert_eq!(pc.max_evaluations, u32::MAX, "0 flights: no budget");
+        assert_eq!((pc.horizon, pc.bfgs.max_iterations), (5, 200));
+        s.max_flights = 40;
+        s.mode = AUVNAV_MODE_TRACK;
+        s.method = AUVNAV_METHOD_GD;
+        let pc = planner_config(&s).unwrap();
+        assert_eq!(pc.max_evaluations, 40);
+        assert_eq!(
+            (pc.mode, pc.method),
+            (Mode::TrackWise, Method::GradientDescent)
+        );
+    }
+
+    #[test]
+    fn the_default_vehicle_is_the_papers_plant() {
+        let tf: TransferFunction<3> = transfer_function(&vehicle_default()).unwrap();
+        assert_eq!(tf, TransferFunction::C_AUV4);
+    }
+}

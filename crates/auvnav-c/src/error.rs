@@ -159,3 +159,24 @@ pub(crate) fn status(s: PlanStatus) -> u32 {
         _ => crate::types::AUVNAV_STATUS_INFEASIBLE,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_code_has_one_nul_terminated_name() {
+        for (i, (code, n)) in NAMES.iter().enumerate() {
+            assert_eq!(
+                *code,
+                -i32::try_from(i).unwrap(),
+                "codes are 0, -1, -2, ..."
+            );
+            assert_eq!(name(*code), *n);
+            assert!(n.ends_with('\0') && n.starts_with("AUVNAV_"));
+            assert_eq!(n.matches('\0').count(), 1);
+        }
+        assert_eq!(name(1), "AUVNAV_ERR_UNKNOWN\0");
+        assert_eq!(name(i32::MIN), "AUVNAV_ERR_UNKNOWN\0");
+    }
+}

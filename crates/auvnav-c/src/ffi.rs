@@ -89,6 +89,23 @@ unsafe fn ready<'a, T>(slot: *mut Slot<T>, marker: u32) -> Result<&'a mut T, i32
     Ok(unsafe { (*addr_of_mut!((*slot).inner)).assume_init_mut() })
 }
 
+/// The initialized object in `slot`, read only, if its marker says so.
+///
+/// # Safety
+/// As [`ready`], for reads only.
+unsafe fn ready_ref<'a, T>(slot: *const Slot<T>, marker: u32) -> Result<&'a T, i32> {
+    if slot.is_null() {
+        return Err(AUVNAV_ERR_NULL);
+    }
+    // SAFETY: non-null and valid for reads (caller's contract).
+    let flag = unsafe { addr_of!((*slot).ready).read() };
+    if flag != marker {
+        return Err(AUVNAV_ERR_NOT_INITIALIZED);
+    }
+    // SAFETY: the marker says `inner` is fully initialized (`install`).
+    Ok(unsafe { (*addr_of!((*slot).inner)).assume_init_ref() })
+}
+
 /// Builds the object with `make` and installs it in `slot`.
 ///
 /// # Safety
@@ -317,7 +334,7 @@ pub unsafe extern "C" fn auvnav_planner_measured(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn auvnav_planner_track(p: *const auvnav_planner) -> u32 {
     // SAFETY: the caller's contract; only read.
-    match unsafe { ready::<PlannerInner>(p.cast_mut().cast(), PLANNER_READY) } {
+    match unsafe { ready_ref::<PlannerInner>(p.cast(), PLANNER_READY) } {
         Ok(planner) => planner.track(),
         Err(_) => 0,
     }
