@@ -34,4 +34,7 @@ cargo build --lib --release --target thumbv7m-none-eabi
 say "target: on-target tests under QEMU (Cortex-M4F, M7, M3), panic-freedom proof, defmt log"
 bash scripts/qemu-test.sh
 
+say "C interface: header, host gcc and arm-none-eabi-gcc under QEMU, panic-never link (crates/auvnav-c)"
+bash scripts/c-test.sh
+
 say "all tests passed"

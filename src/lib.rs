@@ -89,10 +89,10 @@ pub mod sim;
 
 pub use error::Error;
 pub use model::{
-    Autopilot, AutopilotConfig, AutopilotState, Command, ConfigError, MIN_STEP_LENGTH, Mission,
-    PidGains, PidTerms, Plant, PlantError, Profile, ProfileError, ProfileView, TfKind,
-    TransferFunction, Uncertainty, Vehicle, VehicleConfig, WaypointError, Waypoints, WaypointsView,
-    lower_envelope,
+    Autopilot, AutopilotConfig, AutopilotState, Command, ConfigError, LoopInput, LoopOutput,
+    LoopState, MIN_STEP_LENGTH, Mission, PidGains, PidTerms, Plant, PlantError, Profile,
+    ProfileError, ProfileView, TfKind, TransferFunction, Uncertainty, Vehicle, VehicleConfig,
+    WaypointError, Waypoints, WaypointsView, lower_envelope,
 };
 pub use plan::{
     Method, Mode, OptimizerStop, Plan, PlanConfigError, PlanError, PlanStatus, Planner,

@@ -183,6 +183,62 @@ pub(crate) fn clamp(v: f32, limit: f32) -> f32 {
     }
 }
 
+/// Sorts `v` ascending by `f32::total_cmp`: a heapsort written with
+/// checked accesses only, so no panic path reaches the firmware
+/// (`core`'s sorts keep one for inconsistent orders, which the link-time
+/// proof of the C library cannot see past). Equal keys have equal bits,
+/// so the result is the one any correct sort gives.
+pub(crate) fn sort_total(v: &mut [f32]) {
+    let n = v.len();
+    let mut start = n / 2;
+    while start > 0 {
+        start = start.saturating_sub(1);
+        sift_down(v, start, n);
+    }
+    let mut end = n;
+    while end > 1 {
+        end = end.saturating_sub(1);
+        swap(v, 0, end);
+        sift_down(v, 0, end);
+    }
+}
+
+/// Swaps `v[i]` and `v[j]` when both exist.
+fn swap(v: &mut [f32], i: usize, j: usize) {
+    if let (Some(&a), Some(&b)) = (v.get(i), v.get(j)) {
+        if let Some(x) = v.get_mut(i) {
+            *x = b;
+        }
+        if let Some(y) = v.get_mut(j) {
+            *y = a;
+        }
+    }
+}
+
+/// Restores the max-heap below `root` within `v[..end]`.
+fn sift_down(v: &mut [f32], mut root: usize, end: usize) {
+    let key = |v: &[f32], i: usize| v.get(i).copied().unwrap_or(f32::NAN);
+    loop {
+        let Some(child) = root.checked_mul(2).and_then(|c| c.checked_add(1)) else {
+            return;
+        };
+        if child >= end {
+            return;
+        }
+        let right = child.saturating_add(1);
+        let big = if right < end && key(v, child).total_cmp(&key(v, right)).is_lt() {
+            right
+        } else {
+            child
+        };
+        if key(v, root).total_cmp(&key(v, big)).is_ge() {
+            return;
+        }
+        swap(v, root, big);
+        root = big;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -269,5 +325,35 @@ mod tests {
         assert_eq!(clamp(-3.0, 2.0), -2.0);
         assert_eq!(clamp(1.0, 2.0), 1.0);
         assert!(clamp(f32::NAN, 2.0).is_nan());
+    }
+
+    #[test]
+    fn sort_total_sorts_as_core_does() {
+        // Random lengths and values (a small LCG), with duplicates, signed
+        // zeros and infinities: the same order as `sort_unstable_by`.
+        let mut seed = 12345_u32;
+        let mut next = || {
+            seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            seed
+        };
+        for len in 0..70 {
+            let mut buf = [0.0_f32; 70];
+            for x in buf.iter_mut().take(len) {
+                *x = match next() % 9 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    2 => f32::INFINITY,
+                    3 => f32::NEG_INFINITY,
+                    4 => 7.0,
+                    _ => (next() % 2000) as f32 * 0.37 - 300.0,
+                };
+            }
+            let mut want = buf;
+            want[..len].sort_unstable_by(f32::total_cmp);
+            sort_total(&mut buf[..len]);
+            for (a, b) in buf.iter().zip(&want) {
+                assert_eq!(a.to_bits(), b.to_bits(), "len {len}");
+            }
+        }
     }
 }

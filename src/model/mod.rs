@@ -10,6 +10,7 @@
 //! | `line.rs` | [`Waypoints`] / [`WaypointsView`]: `X_0 < … < X_M` |
 //! | `plant.rs`, `expm.rs` | [`TransferFunction`] → [`Plant`]: realization and exact ZOH in f32 |
 //! | `autopilot.rs` | [`Autopilot`]: the depth → pitch → elevator cascade, the one statement of the control law |
+//! | `engage.rs` | [`Autopilot::step`]: the firmware loop around the cascade: hold, non-finite hold, bumpless re-engage ([`LoopState`]) |
 //! | `vehicle.rs` | [`Vehicle`]: speed, sample time, plant and autopilot validated together, with the stability check |
 //! | `mission.rs` | [`Mission`]: `h_r`, `h_a`, depth limits, declared uncertainty |
 //! | `uncertainty.rs` | [`Uncertainty`] and the certification bottom [`lower_envelope`] |
@@ -17,6 +18,7 @@
 
 mod autopilot;
 mod check;
+mod engage;
 mod expm;
 mod line;
 mod mission;
@@ -27,6 +29,7 @@ mod vehicle;
 
 pub use autopilot::{Autopilot, AutopilotConfig, AutopilotState, Command, PidGains, PidTerms};
 pub use check::ConfigError;
+pub use engage::{LoopInput, LoopOutput, LoopState};
 pub use line::{WaypointError, Waypoints, WaypointsView};
 pub use mission::Mission;
 pub use plant::{Plant, PlantError, TfKind, TransferFunction};

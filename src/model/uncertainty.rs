@@ -180,7 +180,7 @@ pub fn lower_envelope<const S: usize>(
         }
     }
     add(x0, &mut at)?;
-    at.sort_unstable_by(f32::total_cmp);
+    crate::num::sort_total(&mut at);
     let mut xv: Vec<f32, S> = Vec::new();
     let mut bv: Vec<f32, S> = Vec::new();
     for &x in at.iter() {
