@@ -95,6 +95,7 @@
 //! | `fallback.rs` | the closest safe depth, the safe-set boundary |
 
 mod answer;
+mod budget;
 mod candidate;
 mod certify;
 mod commit;
@@ -107,6 +108,7 @@ mod scan;
 mod single;
 mod solve;
 mod status;
+mod within;
 
 pub use answer::Plan;
 pub use certify::certify_line;
