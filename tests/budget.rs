@@ -17,8 +17,8 @@
 mod common;
 
 use auvnav::{
-    Measurement, Mission, PlanError, Planner, PlannerConfig, Profile, Scenario, TrackScore,
-    Uncertainty, Vehicle, VehicleState, Waypoints, lower_envelope,
+    Measurement, Mission, PlanError, Planner, PlannerConfig, Profile, Resumable, Scenario, Step,
+    TrackScore, Uncertainty, Vehicle, VehicleState, Waypoints, lower_envelope,
 };
 use common::{real_profile, real_waypoints};
 
@@ -179,4 +179,60 @@ fn under_declared_uncertainty_each_world_is_a_flight() {
             }
         }
     }
+}
+
+/// The resumable form: every step within its flights, the line as safe as
+/// the blocking call's; `J` against the blocking call printed.
+#[test]
+fn the_resumable_planner_steps_within_its_flights() {
+    let vehicle = Vehicle::c_auv4().unwrap();
+    for (name, h_r, h_a) in LINES {
+        let (x, b) = real_profile(name);
+        let map = Profile::<4096>::new(&x, &b).unwrap();
+        let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+        let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
+        let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
+        let free = fly_line(&sc, u32::MAX, false);
+        for per_step in [10, 30] {
+            let mut r = Resumable::new(Planner::<5>::new(PlannerConfig::default()).unwrap());
+            let mut st = sc.start_state(sc.default_initial_depth());
+            let (mut depths, mut safe, mut j, mut steps) = (Vec::new(), Vec::new(), 0.0, 0);
+            'line: for n in 0..wps.tracks() {
+                r.begin(&st, n, 2000);
+                let p = loop {
+                    let before = r.spent();
+                    let s = match r.step(&sc, per_step) {
+                        Ok(s) => s,
+                        Err(PlanError::StartBelowBottom) if safe.iter().any(|s| !s) => break 'line,
+                        Err(e) => panic!("{name} track {}: {e}", n + 1),
+                    };
+                    steps += 1;
+                    assert!(r.spent() - before <= per_step, "{name}: a step flew more");
+                    if let Step::Done(p) = s {
+                        break p;
+                    }
+                };
+                depths.push(p.depth);
+                safe.push(p.safe);
+                j += p.j;
+                st = p.next_state;
+            }
+            for (t, (&ok, h)) in safe.iter().zip(open_loop(&sc, &depths)).enumerate() {
+                if ok {
+                    assert!(h >= h_a, "{name} per step {per_step} track {}: {h}", t + 1);
+                }
+                if free.safe.get(t) == Some(&true) {
+                    assert!(ok, "{name} per step {per_step} track {}: not safe", t + 1);
+                }
+            }
+            println!(
+                "{name}: resumable, {per_step} flights a step: J {j:.4e} in {steps} steps (blocking {:.4e})",
+                free.j
+            );
+        }
+    }
+    println!(
+        "size of Resumable<5>: {} bytes",
+        std::mem::size_of::<Resumable<5>>()
+    );
 }

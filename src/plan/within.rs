@@ -155,6 +155,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             Mode::TrackWise => 1,
             Mode::Horizon => self.cfg.horizon.min(K).min(len),
         };
+        // (A resumed call's warm start already covers the horizon.)
+        if self.warm.is_some_and(|w| w.track == track && w.len >= h) {
+            return;
+        }
         let mu = self.warm.map_or(self.cfg.penalty_weight, |w| w.mu);
         let mut depths = [0.0; K];
         for (dst, src) in depths.iter_mut().zip(p.iter()) {
@@ -229,21 +233,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         })
     }
 
-    /// The workspace after a fallback: the horizon is the committed depth,
-    /// its objective `j` (m³); the next call starts warm from the
+    /// The workspace after a fallback: the horizon is the continuation's
+    /// first tracks, its objective the committed track's `j` (m³); the next call starts warm from the
     /// continuation `depths` (`len` tracks from `track`).
     fn follow(&mut self, track: usize, depths: &[f32; MAX_TRACKS], len: usize, j: f32) {
+        let h = match self.cfg.mode {
+            Mode::TrackWise => 1,
+            Mode::Horizon => self.cfg.horizon.min(K).min(len),
+        };
         self.work.z = [0.0; K];
-        if let Some(first) = self.work.z.first_mut() {
-            *first = depths[0];
+        for (dst, src) in self.work.z.iter_mut().zip(depths.iter()).take(h) {
+            *dst = *src;
         }
         self.work.j = j;
         self.work.grad_norm = 0.0;
         self.work.iterations = 0;
         self.work.history.clear();
         let _ = self.work.history.push(j);
-        self.horizon_len = 1;
-        let h = self.cfg.horizon.min(K).min(len);
+        self.horizon_len = h.max(1);
         let warm_len = h.saturating_sub(1);
         self.warm = (self.cfg.mode == Mode::Horizon && warm_len > 0).then(|| {
             let mut w = [0.0; K];
