@@ -5,7 +5,9 @@
 //! flight and the worlds' advance.
 //!
 //! A call first sets aside the flights its *fallback* needs: the previous
-//! call's continuation (already certified; without one, the climb to the
+//! call's continuation (already certified; without one, the terrain rule —
+//! `h_r` above the highest mapped bottom of each track and the next — when
+//! it certifies and the budget has its flight, else the climb to the
 //! shallowest allowed depth), its committed track flown nominally and the
 //! worlds moved on. The candidate gets what is left after that and after
 //! its own certification; the optimizer stops on its share

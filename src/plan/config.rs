@@ -83,7 +83,8 @@ pub struct PlannerConfig {
     /// (one line flight per declared world), the committed depth's flight
     /// and the worlds' advance; ≥ 1, a hard bound ([`crate::Plan::evaluations`]
     /// never exceeds it). The call sets aside the flights of its fallback
-    /// (the previous certified continuation, else the climb) and commits
+    /// (the previous certified continuation, else a terrain rule or the
+    /// climb) and commits
     /// the best certified plan it finds within the rest (the optimizer's
     /// stop is then `OptimizerStop::Budget`): a budget costs `J`, never
     /// safety. Below the fallback's flights (1 when nothing is declared,

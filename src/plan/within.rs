@@ -209,9 +209,28 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             limit: u32::MAX,
         };
         let (flown, cert) = if guaranteed && self.budget.known.is_none() && self.budget.nominal {
-            let (f, cert) = fly_line(sc, state, track, depths.get(..len).unwrap_or(&[]))?;
-            fl.count = fl.count.saturating_add(1);
-            (f, Some(cert))
+            // With no continuation, the terrain rule before the climb, when
+            // the budget has a flight for each.
+            let fresh = self.previous(track, len).is_none();
+            let mut held = None;
+            if fresh && self.budget.limit.saturating_sub(fl.count) >= 2 {
+                let rule = terrain_rule(sc, track, len);
+                fl.count = fl.count.saturating_add(1);
+                if let Ok((f, c)) = fly_line(sc, state, track, rule.get(..len).unwrap_or(&[]))
+                    && c.all >= h_safe
+                {
+                    depths = rule;
+                    held = Some((f, Some(c)));
+                }
+            }
+            match held {
+                Some(h) => h,
+                None => {
+                    let (f, c) = fly_line(sc, state, track, depths.get(..len).unwrap_or(&[]))?;
+                    fl.count = fl.count.saturating_add(1);
+                    (f, Some(c))
+                }
+            }
         } else {
             let (score, next) = fl.fly(depths[0])?;
             let known = self.budget.known.filter(|_| guaranteed);
@@ -307,4 +326,40 @@ fn fly_line<const N: usize>(
         all,
     };
     Ok((f, cert))
+}
+
+/// The terrain rule: on each track, `h_r` above the highest mapped bottom
+/// of that track and the next (so that the vehicle is up before a rise),
+/// within the depth limits, m.
+fn terrain_rule<const N: usize>(
+    sc: &Scenario<'_, N>,
+    track: usize,
+    len: usize,
+) -> [f32; MAX_TRACKS] {
+    let m = sc.mission();
+    let [lo, hi] = m.depth_limits();
+    let wp = sc.waypoints().positions();
+    let p = sc.profile();
+    let mut out = [lo; MAX_TRACKS];
+    for (j, slot) in out.iter_mut().enumerate().take(len) {
+        let t = track.saturating_add(j);
+        let a = wp.get(t).copied().unwrap_or(0.0);
+        let b = wp
+            .get(t.saturating_add(2))
+            .or_else(|| wp.get(t.saturating_add(1)))
+            .copied()
+            .unwrap_or(a);
+        let ends = [a, b].into_iter().filter_map(|x| p.depth_at(x).ok());
+        let inside = p
+            .positions()
+            .iter()
+            .zip(p.depths())
+            .filter(|(x, _)| **x >= a && **x <= b)
+            .map(|(_, d)| *d);
+        let top = ends.chain(inside).fold(f32::INFINITY, f32::min);
+        if top.is_finite() {
+            *slot = (top - m.reference_altitude()).max(lo).min(hi);
+        }
+    }
+    out
 }
