@@ -33,7 +33,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
     }
 
-    /// [`Planner::plan`] within `limit` flights (module docs).
+    /// [`Planner::plan`] within `limit` flights (module docs). Not
+    /// inlined: its frame stays off the unbudgeted call's stack.
+    #[inline(never)]
     pub(super) fn plan_within(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -187,6 +189,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// certificate when known, or (the nominal world over the map the only
     /// one) from the same line flight. The workspace and the next call's
     /// warm start follow it.
+    #[inline(never)]
     fn fallback_candidate(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -289,6 +292,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 /// The nominal line flight of `depths` from `state` on `track` (one flight,
 /// over the map): the first track's flight and the certificate it is when
 /// the nominal world over the map is the only one.
+#[inline(never)]
 fn fly_line<const N: usize>(
     sc: &Scenario<'_, N>,
     state: &VehicleState<N>,
@@ -331,6 +335,7 @@ fn fly_line<const N: usize>(
 /// The terrain rule: on each track, `h_r` above the highest mapped bottom
 /// of that track and the next (so that the vehicle is up before a rise),
 /// within the depth limits, m.
+#[inline(never)]
 fn terrain_rule<const N: usize>(
     sc: &Scenario<'_, N>,
     track: usize,
