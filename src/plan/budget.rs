@@ -23,7 +23,8 @@
 //! - the call starts where the last one predicted and that call was
 //!   certified: its continuation's certificate still holds (the worlds'
 //!   flights from the kept states are the same flights), so `1 + W`
-//!   (`1` nominal);
+//!   (`1` nominal). That holds for the same scenario: a caller that changes
+//!   the map or the line between calls calls `Planner::reset` first;
 //! - otherwise (the first call, a measured start state, an uncertified
 //!   last call) the anchor is certified again: `1 + 2 W` (`1` nominal: the
 //!   anchor's line flight is its track's flight too).
