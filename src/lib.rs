@@ -96,7 +96,7 @@ pub use model::{
 };
 pub use plan::{
     Method, Mode, OptimizerStop, Plan, PlanConfigError, PlanError, PlanStatus, Planner,
-    PlannerConfig,
+    PlannerConfig, Resumable, Step,
 };
 pub use sim::{
     Evaluation, Measurement, Sample, Scenario, SimError, TrackScore, VehicleState, World,

@@ -8,6 +8,7 @@
 use crate::optim::Bounds;
 use crate::sim::{Scenario, TrackScore, VehicleState};
 
+use super::certify::Certificate;
 use super::fallback::{Flown, fallback};
 use super::flights::Flights;
 use super::objective::PlanObjective;
@@ -45,6 +46,9 @@ pub(super) struct Candidate<const N: usize> {
     pub evaluations: u32,
     /// `h_a + m_s`, m.
     pub h_safe: f32,
+    /// The continuation's certificate when already known (a budgeted
+    /// call's fallback, `budget.rs`).
+    pub cert: Option<Certificate>,
 }
 
 impl<const K: usize, const N: usize> Planner<K, N> {
@@ -73,6 +77,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             state,
             track,
             count: 0,
+            limit: self.budget.candidate,
         };
         let mut scan = ScanLog::default();
         let (mut z0, mut curvature, from) = self.start_point(&s, &mut fl, &mut scan)?;
@@ -88,7 +93,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mu = if single { 0.0 } else { s.mu };
         let mut obj = PlanObjective::new(penalized, state, track, s.h, mu);
         obj.guard = single.then_some(s.h_safe);
-        obj.budget = self.cfg.max_evaluations;
+        obj.budget = self.budget.optimizer(fl.count)?;
         let first_step = if s.warm.is_some() {
             self.cfg.bfgs.first_step * WARM_FIRST_STEP
         } else {
@@ -122,6 +127,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             iterations,
             evaluations: fl.count,
             h_safe: s.h_safe,
+            cert: None,
         })
     }
 
@@ -187,7 +193,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The call's horizon, first penalty weight, box and certified
     /// altitude; checks the track and the start state.
-    fn setup(
+    pub(super) fn setup(
         &self,
         sc: &Scenario<'_, N>,
         state: &VehicleState<N>,
@@ -358,6 +364,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             iterations,
             evaluations,
             h_safe,
+            cert: None,
         }
     }
 }

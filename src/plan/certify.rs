@@ -80,13 +80,14 @@ pub(super) struct Certificate {
 impl<const N: usize> Tube<N> {
     /// Makes the tube ready for a call on `track` from `state`: kept if it
     /// is the state the last commit predicted for this track with the same
-    /// worlds, else every world starts from `state`.
+    /// worlds, else every world starts from `state`. Returns whether it
+    /// was kept.
     pub fn prepare(
         &mut self,
         (worlds, margin): (Vec<World, MAX_WORLDS>, f32),
         state: &VehicleState<N>,
         track: usize,
-    ) {
+    ) -> bool {
         self.margin = margin;
         let kept =
             self.track == track && self.nominal.as_ref() == Some(state) && self.worlds == worlds;
@@ -96,6 +97,7 @@ impl<const N: usize> Tube<N> {
             self.track = track;
             self.nominal = Some(*state);
         }
+        kept
     }
 
     /// After committing `depth` on the track the tube starts: each world's

@@ -98,6 +98,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 state,
                 track,
                 count: flights,
+                limit: u32::MAX,
             };
             let (score, next) = fl.fly(depth)?;
             flights = fl.count;
@@ -112,6 +113,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (only_nominal, &mut flights),
         );
         let safe = chosen.cert.all >= cand.h_safe;
+        self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
         let status = self.status(sc, &cand, &chosen, safe);
         Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
     }
@@ -133,12 +135,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         let shallow = sc.mission().depth_limits()[0];
         let c = self.candidate_continuation(track, len, cand.flown.depth, shallow);
-        let cert_c = if len == 1 {
-            self.certify_one(sc, bottom, state, &cand.flown, flights)
-        } else {
-            self.tube
-                .certify(sc, bottom, c.get(..len).unwrap_or(&[]), flights)
-        };
+        let cert_c = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
         let candidate = Chosen {
             depths: c,
             len,
@@ -159,8 +156,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let cert_c2 = if same {
             cert_c
         } else {
-            self.tube
-                .certify(sc, bottom, c2.get(..len).unwrap_or(&[]), flights)
+            let spare = self.budget.anchor;
+            self.certify_within(sc, bottom, c2.get(..len).unwrap_or(&[]), flights, spare)
         };
         if cert_c2.all >= cand.h_safe {
             return Ok(Chosen {
@@ -178,10 +175,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // Anchors: the previous continuation, then the climb.
         let prev = self.previous_continuation(track, len, shallow);
         let mut best = candidate;
-        for a in prev.into_iter().chain([[shallow; MAX_TRACKS]]) {
-            let cert_a = self
-                .tube
-                .certify(sc, bottom, a.get(..len).unwrap_or(&[]), flights);
+        let anchors = prev.map(|p| (p, true)).into_iter();
+        for (a, is_prev) in anchors.chain([([shallow; MAX_TRACKS], false)]) {
+            let cert_a = match self.budget.known_anchor(is_prev, (&a, &c, cert_c), len) {
+                Some(known) => known,
+                None => self.certify_within(sc, bottom, a.get(..len).unwrap_or(&[]), flights, 0),
+            };
             if cert_a.all >= cand.h_safe {
                 let ends = ((&a, cert_a), (&c, cert_c));
                 return Ok(self.search(sc, bottom, ends, len, cand.h_safe, flights));
@@ -196,6 +195,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         }
         Ok(best)
+    }
+
+    /// The candidate continuation's certificate: known (a budgeted
+    /// fallback's), its flight's (one track), or flown.
+    fn certify_candidate(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (state, cand): (&VehicleState<N>, &Candidate<N>),
+        (c, len): (&[f32; MAX_TRACKS], usize),
+        flights: &mut u32,
+    ) -> Certificate {
+        let c = c.get(..len).unwrap_or(&[]);
+        match cand.cert {
+            Some(known) => known,
+            None if c.len() == 1 => self.certify_one(sc, bottom, state, &cand.flown, flights),
+            None => self.tube.certify(sc, bottom, c, flights),
+        }
     }
 
     /// The previous call's continuation for tracks `track..track + len`,
@@ -265,7 +282,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (0.0, Some(cert_a.all - h_safe)),
             (1.0, Some(cert_c.all - h_safe)),
         );
+        let budget = self.budget;
         let r = root::safe_boundary(good, bad, rule, |t| {
+            if !budget.afford(*flights) {
+                return Err(());
+            }
             let d = at(t);
             let cert = self
                 .tube
@@ -402,7 +423,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
 /// Whether the only world is the nominal one over the map, from `state`:
 /// the nominal flight is then the certificate.
-fn nominal_only<const N: usize>(
+pub(super) fn nominal_only<const N: usize>(
     sc: &Scenario<'_, N>,
     bottom: ProfileView<'_>,
     tube: &Tube<N>,
@@ -414,7 +435,7 @@ fn nominal_only<const N: usize>(
 
 /// The bottom certificates are flown over: the scenario's certification
 /// bottom, or the map itself when the map is declared exact.
-fn certification_bottom<'a, const N: usize>(
+pub(super) fn certification_bottom<'a, const N: usize>(
     sc: &Scenario<'a, N>,
 ) -> Result<ProfileView<'a>, PlanError> {
     match sc.certification_bottom() {

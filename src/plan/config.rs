@@ -78,11 +78,19 @@ pub struct PlannerConfig {
     /// (see the module docs). Default 16 (bisection alone would bring a
     /// 50 m bracket under a millimetre); it usually stops after 1 to 4.
     pub bisection_steps: u32,
-    /// Most objective-and-gradient evaluations of the optimizer per call,
-    /// ≥ 1 (the scan, the verification and the certification flights come
-    /// on top: they are what safety rests on). When it runs out the
-    /// optimizer stops where it is (`OptimizerStop::Budget`): it costs `J`,
-    /// never safety. Default `u32::MAX` (the iteration cap decides).
+    /// Most flights (simulations) of one call, every kind counted: scan,
+    /// optimizer evaluations, verification and fallback, certification
+    /// (one line flight per declared world), the committed depth's flight
+    /// and the worlds' advance; ≥ 1, a hard bound ([`crate::Plan::evaluations`]
+    /// never exceeds it). The call sets aside the flights of its fallback
+    /// (the previous certified continuation, else a terrain rule or the
+    /// climb) and commits
+    /// the best certified plan it finds within the rest (the optimizer's
+    /// stop is then `OptimizerStop::Budget`): a budget costs `J`, never
+    /// safety. Below the fallback's flights (1 when nothing is declared,
+    /// `1 + 2 W` for `W` declared worlds on a fresh start) the call returns
+    /// [`crate::PlanError::BudgetTooSmall`]. Default `u32::MAX`: no budget
+    /// (the iteration cap decides).
     pub max_evaluations: u32,
 }
 

@@ -10,6 +10,9 @@ pub(super) struct Flights<'s, 'a, const N: usize> {
     pub track: usize,
     /// Flights so far.
     pub count: u32,
+    /// Most flights (`u32::MAX`: no budget); a flight past it is refused
+    /// with [`SimError::FlightBudget`].
+    pub limit: u32,
 }
 
 impl<const N: usize> Flights<'_, '_, N> {
@@ -26,6 +29,9 @@ impl<const N: usize> Flights<'_, '_, N> {
         j: usize,
         z: f32,
     ) -> Result<(TrackScore, VehicleState<N>), SimError> {
+        if self.count >= self.limit {
+            return Err(SimError::FlightBudget);
+        }
         self.count = self.count.saturating_add(1);
         let mut score = [TrackScore::default()];
         let next = self

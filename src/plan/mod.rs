@@ -84,6 +84,8 @@
 //! | `status.rs` | [`PlanStatus`], [`OptimizerStop`], [`PlanError`] |
 //! | `answer.rs` | [`Plan`], the small answer |
 //! | `planner.rs` | [`Planner`]: the caller-owned planner and its entry point |
+//! | `budget.rs`, `within.rs` | a call within a flight budget: the split, the fallback |
+//! | `resumable.rs` | [`Resumable`]: one call as bounded steps |
 //! | `candidate.rs` | one call's candidate, step by step |
 //! | `commit.rs` | what is committed: the certified continuation (§11) |
 //! | `certify.rs` | certificates over the declared worlds (§12), [`certify_line`] |
@@ -95,6 +97,7 @@
 //! | `fallback.rs` | the closest safe depth, the safe-set boundary |
 
 mod answer;
+mod budget;
 mod candidate;
 mod certify;
 mod commit;
@@ -103,13 +106,16 @@ mod fallback;
 mod flights;
 mod objective;
 mod planner;
+mod resumable;
 mod scan;
 mod single;
 mod solve;
 mod status;
+mod within;
 
 pub use answer::Plan;
 pub use certify::certify_line;
 pub use config::{MAX_SCAN, Method, Mode, PlanConfigError, PlannerConfig};
 pub use planner::{MAX_TRACKS, Planner};
+pub use resumable::{Resumable, Step};
 pub use status::{OptimizerStop, PlanError, PlanStatus};

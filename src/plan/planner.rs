@@ -5,7 +5,8 @@
 use crate::optim::Outcome;
 use crate::sim::{Scenario, VehicleState};
 
-use super::certify::Tube;
+use super::budget::Budget;
+use super::certify::{Certificate, Tube};
 use super::{Plan, PlanError, PlannerConfig};
 
 /// Most tracks a line may have in horizon mode: the continuation that a
@@ -36,6 +37,8 @@ pub struct Planner<const K: usize, const N: usize = 3> {
     pub(super) cont: Continuation,
     /// Each declared world's state at the next track.
     pub(super) tube: Tube<N>,
+    /// The current call's flight budget (`budget.rs`).
+    pub(super) budget: Budget,
 }
 
 #[cfg(feature = "defmt")]
@@ -67,6 +70,9 @@ pub(super) struct Continuation {
     pub track: usize,
     pub depths: [f32; MAX_TRACKS],
     pub len: usize,
+    /// The certificate it was committed with (with the depth before it),
+    /// when that was safe in horizon mode.
+    pub certified: Option<Certificate>,
 }
 
 impl Continuation {
@@ -75,6 +81,7 @@ impl Continuation {
         track: 0,
         depths: [0.0; MAX_TRACKS],
         len: 0,
+        certified: None,
     };
 
     /// The depth for track `t`, if covered.
@@ -99,6 +106,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             horizon_len: 0,
             cont: Continuation::NONE,
             tube: Tube::default(),
+            budget: Budget::NONE,
         })
     }
 
@@ -146,14 +154,21 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// [`PlanError`] for a track outside the line, a start state that is
     /// not finite, not on the track or below the bottom, a line longer than
     /// [`MAX_TRACKS`] in horizon mode, declared map uncertainty without a
-    /// certification bottom, or a simulation that fails at the very start.
+    /// certification bottom, a flight budget
+    /// ([`PlannerConfig::max_evaluations`]) below what committing the
+    /// fallback needs ([`PlanError::BudgetTooSmall`]), or a simulation that
+    /// fails at the very start.
     pub fn plan(
         &mut self,
         sc: &Scenario<'_, N>,
         state: &VehicleState<N>,
         track: usize,
     ) -> Result<Plan<N>, PlanError> {
-        let cand = self.candidate(sc, state, track)?;
-        self.commit(sc, state, track, cand)
+        if self.cfg.max_evaluations == u32::MAX {
+            self.budget = Budget::NONE;
+            let cand = self.candidate(sc, state, track)?;
+            return self.commit(sc, state, track, cand);
+        }
+        self.plan_within(sc, state, track, self.cfg.max_evaluations)
     }
 }

@@ -126,6 +126,13 @@ pub enum PlanError {
     /// The mission declares map uncertainty but the scenario has no
     /// certification bottom ([`crate::Scenario::with_certification_bottom`]).
     NoCertificationBottom,
+    /// The flight budget ([`crate::PlannerConfig::max_evaluations`]) is
+    /// below the flights that committing the call's fallback needs (see
+    /// [`crate::Planner::plan`]); nothing was flown.
+    BudgetTooSmall {
+        /// The least budget this call needs, flights.
+        needed: u32,
+    },
     /// The simulation failed where no fallback is possible (at the start).
     Sim(SimError),
 }
@@ -140,6 +147,12 @@ impl fmt::Display for PlanError {
             Self::NoCertificationBottom => f.write_str(
                 "map uncertainty declared but no certification bottom given (see lower_envelope)",
             ),
+            Self::BudgetTooSmall { needed } => {
+                write!(
+                    f,
+                    "the flight budget is below the {needed} flights a call needs"
+                )
+            }
             Self::Sim(e) => write!(f, "simulation failed: {e}"),
         }
     }

@@ -31,6 +31,10 @@ pub enum SimError {
     StepLimit,
     /// A scored position fell outside the bottom profile.
     OutOfProfile,
+    /// Not a simulation failure: the planner refused the flight because
+    /// its call's flight budget was spent (internal to the planner, which
+    /// then commits its fallback; never returned by a simulation).
+    FlightBudget,
 }
 
 impl fmt::Display for SimError {
@@ -45,6 +49,7 @@ impl fmt::Display for SimError {
             Self::Diverged => f.write_str("simulation diverged"),
             Self::StepLimit => f.write_str("simulation step limit reached"),
             Self::OutOfProfile => f.write_str("simulated position outside the bottom profile"),
+            Self::FlightBudget => f.write_str("the planner's flight budget is spent"),
         }
     }
 }

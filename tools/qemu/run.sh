@@ -13,6 +13,8 @@
 # and its output is turned into a table by tools/qemu/bench_table.sh.
 # Symbols are read with the host's binutils `nm` (installed with cc).
 # A run that does not end within $QEMU_TIMEOUT seconds (default 600) fails.
+# $QEMU_ICOUNT, if set, is passed as `-icount` (e.g. shift=3,sleep=off: a
+# fixed virtual instruction rate, idle time skipped; the real-time example).
 set -uo pipefail
 
 elf=${1:?usage: run.sh ELF}
@@ -32,7 +34,8 @@ esac
 
 qemu=(timeout --foreground "${QEMU_TIMEOUT:-600}" qemu-system-arm
   -machine "$machine" -cpu "$cpu" -nographic -monitor none -serial none
-  -semihosting-config enable=on,target=native -kernel "$elf")
+  -semihosting-config enable=on,target=native -kernel "$elf"
+  ${QEMU_ICOUNT:+-icount "$QEMU_ICOUNT"})
 
 syms=$(nm -- "$elf" 2>/dev/null) || syms=
 if grep -q ' auvnav_bench_start$' <<<"$syms"; then

@@ -255,3 +255,100 @@ pub mod image {
         }
     }
 }
+
+/// The CMSDK APB timer 0 of QEMU's `mps2-an386` (base `0x4000_0000`,
+/// interrupt 8, clocked at the board's 25 MHz system clock) and a handler
+/// for its interrupt: what the real-time example (`examples/qemu_realtime.rs`)
+/// needs without `unsafe` of its own.
+pub mod timer {
+    use core::cell::Cell;
+    use core::ptr::{read_volatile, write_volatile};
+
+    use cortex_m::interrupt::Mutex;
+    use cortex_m_rt::exception;
+
+    const BASE: usize = 0x4000_0000;
+    const CTRL: usize = BASE;
+    const VALUE: usize = BASE + 4;
+    const RELOAD: usize = BASE + 8;
+    const INTSTATUS: usize = BASE + 12;
+    /// The timer's interrupt number.
+    pub const IRQ: u16 = 8;
+    /// The timer's input clock, Hz (the mps2 boards' `SYSCLK_FRQ`).
+    pub const CLOCK_HZ: u32 = 25_000_000;
+
+    static HANDLER: Mutex<Cell<Option<fn()>>> = Mutex::new(Cell::new(None));
+
+    #[derive(Clone, Copy)]
+    struct Irq;
+    // SAFETY: the timer's interrupt number on this board.
+    unsafe impl cortex_m::interrupt::InterruptNumber for Irq {
+        fn number(self) -> u16 {
+            IRQ
+        }
+    }
+
+    fn read(addr: usize) -> u32 {
+        // SAFETY: a register of the timer, always mapped on the board.
+        unsafe { read_volatile(addr as *const u32) }
+    }
+
+    fn write(addr: usize, v: u32) {
+        // SAFETY: as `read`.
+        unsafe { write_volatile(addr as *mut u32, v) }
+    }
+
+    /// Starts the timer with an interrupt every `reload + 1` clock ticks,
+    /// calling `handler` (at the priority `prio`, 0 the highest).
+    pub fn start(reload: u32, prio: u8, handler: fn()) {
+        cortex_m::interrupt::free(|cs| HANDLER.borrow(cs).set(Some(handler)));
+        write(CTRL, 0);
+        write(RELOAD, reload);
+        write(VALUE, reload);
+        write(INTSTATUS, 1);
+        if let Some(mut p) = cortex_m::Peripherals::take() {
+            // SAFETY: the priority of an interrupt nothing else uses.
+            unsafe {
+                p.NVIC.set_priority(Irq, prio);
+                cortex_m::peripheral::NVIC::unmask(Irq);
+            }
+        }
+        // Enable, interrupt enable.
+        write(CTRL, 1 | 8);
+    }
+
+    /// Stops the timer.
+    pub fn stop() {
+        write(CTRL, 0);
+        cortex_m::peripheral::NVIC::mask(Irq);
+    }
+
+    /// The counter (counts down from the reload value).
+    pub fn value() -> u32 {
+        read(VALUE)
+    }
+
+    /// The reload value.
+    pub fn reload() -> u32 {
+        read(RELOAD)
+    }
+
+    /// Whether the interrupt is pending at the timer (a period ended).
+    pub fn pending() -> bool {
+        read(INTSTATUS) & 1 != 0
+    }
+
+    /// Clears the timer's interrupt.
+    pub fn clear() {
+        write(INTSTATUS, 1);
+    }
+
+    #[exception]
+    unsafe fn DefaultHandler(irqn: i16) {
+        let h = cortex_m::interrupt::free(|cs| HANDLER.borrow(cs).get());
+        match h {
+            Some(f) if irqn == IRQ as i16 => f(),
+            _ => crate::exit(false),
+        }
+    }
+}
