@@ -9,6 +9,7 @@
 
 mod args;
 mod fail;
+mod fly;
 mod input;
 mod plot;
 mod report;
@@ -30,7 +31,13 @@ const ENVELOPE: usize = 3 * SAMPLES + 1;
 use report::{Report, TrackReport, TrajRow};
 
 fn main() -> ExitCode {
-    match run(Args::parse_os(std::env::args_os().skip(1))) {
+    let first = std::env::args_os().nth(1);
+    let result = if first.as_deref() == Some(std::ffi::OsStr::new("fly")) {
+        fly::main(std::env::args().skip(2))
+    } else {
+        run(Args::parse_os(std::env::args_os().skip(1)))
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(Fail::Help) => {
             println!("{}", args::USAGE);
