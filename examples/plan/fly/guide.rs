@@ -73,11 +73,15 @@ pub struct Line<'a> {
 #[derive(Clone, Debug, Default)]
 pub struct Record {
     pub min_altitude: f64,
+    /// Where (true x, m) the least altitude was met.
+    pub min_at: f64,
     pub sum_sq: f64,
     pub sum_alt: f64,
     pub samples: u64,
     pub below_steps: u64,
     pub lock_steps: u64,
+    /// DVL pings (sonar guidances).
+    pub pings: u64,
     pub collided: bool,
     /// Per track: the flown least altitude and the planner's prediction
     /// of it (planned guidances), m.
@@ -196,6 +200,9 @@ pub fn fly(
         let m_pitch = theta + world.v["pitch_noise"] * rng.normal();
         let m_q = q + world.v["pitch_rate_noise"] * rng.normal();
         let alt = world.bottom(&line.map, b.x) - b.d;
+        if alt < rec.min_altitude {
+            rec.min_at = b.x;
+        }
         score(&mut rec, alt, h_r, h_a);
         if xi >= x_end || rec.collided {
             break;
@@ -209,6 +216,7 @@ pub fn fly(
         let ping = if kind.sonar() {
             let p = sonar::ping(world, &line.map, &mut rng, b.x, b.d, theta);
             rec.lock_steps += u64::from(p.lock);
+            rec.pings += 1;
             Some(p)
         } else {
             None

@@ -269,7 +269,7 @@ fn report(line: &Line<'_>, a: &Args, flights: &[Vec<Record>], json: bool) -> Str
     for (g, &kind) in a.guidance.iter().enumerate() {
         let recs: Vec<&Record> = flights.iter().map(|f| &f[g]).collect();
         let n = recs.len() as f64;
-        let samples: u64 = recs.iter().map(|r| r.samples).sum();
+        let pings: u64 = recs.iter().map(|r| r.pings).sum();
         let est: Vec<[f64; 3]> = recs.iter().flat_map(|r| r.est.iter().copied()).collect();
         let max_abs = |k: usize| est.iter().map(|e| e[k].abs()).fold(0.0, f64::max);
         let rms = |k: usize| (est.iter().map(|e| e[k] * e[k]).sum::<f64>() / est.len().max(1) as f64).sqrt();
@@ -285,7 +285,8 @@ fn report(line: &Line<'_>, a: &Args, flights: &[Vec<Record>], json: bool) -> Str
             "mean_altitude": recs.iter().map(|r| r.sum_alt / r.samples as f64).sum::<f64>() / n,
             "time_below_min_altitude_s": recs.iter().map(|r| r.below_steps as f64 * ts).sum::<f64>() / n,
             "max_time_below_min_altitude_s": recs.iter().map(|r| r.below_steps as f64 * ts).fold(0.0, f64::max),
-            "bottom_lock_fraction": kind.sonar().then(|| recs.iter().map(|r| r.lock_steps).sum::<u64>() as f64 / samples as f64),
+            "bottom_lock_fraction": kind.sonar().then(|| recs.iter().map(|r| r.lock_steps).sum::<u64>() as f64 / pings.max(1) as f64),
+            "first_flight_worst_at_x": first.map(|r| r.min_at),
             "first_flight_track_min_altitude": first.map(|r| r.track_min.clone()),
             "first_flight_predicted_min_altitude": first.map(|r| r.predicted.clone()),
             "estimator": (!est.is_empty()).then(|| serde_json::json!({

@@ -40,7 +40,7 @@ pub const KEYS: &[(&str, f64, &str)] = &[
     ("map_horizontal_offset", 0.0, "map displaced along track, m"),
     ("nav_drift", 0.0, "navigation drift, m per m travelled"),
     ("dvl_range", 100.0, "DVL bottom-track slant range, m (600 kHz)"),
-    ("dvl_min_grazing", 20.0, "least grazing angle a beam locks at, deg"),
+    ("dvl_min_grazing", 30.0, "least grazing angle a beam locks at, deg"),
     ("dvl_noise", 0.0, "DVL range noise sigma, m"),
     ("dvl_timeout", 10.0, "bottom follower: depth hold on lock loss, s"),
 ];
