@@ -7,6 +7,7 @@
 //! so the numbers do not depend on the thread count (rayon over flights).
 
 mod guide;
+mod plot;
 mod sonar;
 mod world;
 
@@ -28,13 +29,15 @@ use world::{Flight, Map, Rng, WorldSpec};
 pub const USAGE: &str = "\
 plan fly [--profile P.csv --waypoints W.csv] [--config VEHICLE.toml]
          [--world WORLD.toml] [--guidance G1,G2,...] [--runs N] [--seed S]
-         [--horizon K] [--json]
+         [--horizon K] [--json] [--plot OUT.svg]
 
 Flies the line in closed loop N times (default 1, seed default 1) in the
 world of WORLD.toml (default: the planner's model exactly) with each
 guidance (default all): horizon, certified, track, bottom-follow,
 min-altitude, constant. certified uses the config's declared uncertainty;
-horizon the same planner with none declared.";
+horizon the same planner with none declared. --plot draws flight 0 of
+each guidance over its true bottom (below h_a in red, DVL lock lost in
+grey).";
 
 struct Args {
     profile: Option<PathBuf>,
@@ -46,6 +49,7 @@ struct Args {
     seed: u64,
     horizon: Option<usize>,
     json: bool,
+    plot: Option<PathBuf>,
 }
 
 fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
@@ -59,6 +63,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
         seed: 1,
         horizon: None,
         json: false,
+        plot: None,
     };
     while let Some(flag) = it.next() {
         let mut value = || it.next().ok_or_else(|| Fail::usage(format!("{flag} needs a value")));
@@ -68,6 +73,7 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
             "--waypoints" => a.waypoints = Some(value()?.into()),
             "--config" => a.config = Some(value()?.into()),
             "--world" => a.world = Some(value()?.into()),
+            "--plot" => a.plot = Some(value()?.into()),
             "--json" => a.json = true,
             "--guidance" => {
                 a.guidance = value()?
@@ -183,6 +189,21 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
         constant,
     };
     let flights = fly_all(&line, &spec, &a)?;
+    if let (Some(path), Some(first)) = (&a.plot, flights.first()) {
+        let tracks: Vec<plot::Track<'_>> = a
+            .guidance
+            .iter()
+            .zip(first)
+            .map(|(&k, r)| plot::Track { name: k.name(), sonar: k.sonar(), path: &r.path })
+            .collect();
+        let title = format!(
+            "{profile_name}: flight 0 of seed {} ({}), true bottom, h_a = {} m",
+            a.seed,
+            a.world.as_ref().map_or("nominal world".into(), |p| p.display().to_string()),
+            line.nominal.mission().min_altitude()
+        );
+        plot::draw(path, &title, f64::from(line.nominal.mission().min_altitude()), (&line.map.x, &line.map.b), &tracks)?;
+    }
     println!("{}", report(&line, &a, &flights, a.json));
     Ok(())
 }
@@ -245,7 +266,7 @@ fn fly_all(line: &Line<'_>, spec: &WorldSpec, a: &Args) -> Result<Vec<Vec<Record
             let recs = a
                 .guidance
                 .iter()
-                .map(|&k| guide::fly(line, &world, k, noise, false))
+                .map(|&k| guide::fly(line, &world, k, noise, i == 0 && a.plot.is_some()))
                 .collect::<Result<Vec<_>, _>>()
                 .map_err(|e| format!("flight {i}: {e}"));
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
