@@ -1,14 +1,16 @@
 """The README's "Flown" study: `plan fly` on every shared profile in the
 nominal, realistic and harsh worlds (examples/plan/fly/worlds/), every
 guidance; prints a markdown table per world. Usage:
-  python3 scripts/flown_study.py [RUNS_REALISTIC] [RUNS_HARSH] [PLAN_BINARY]
-(defaults 1000 and 100, target/release/examples/plan; build it first with
-`cargo build --release --example plan`). The nominal world has no random
+  python3 scripts/flown_study.py [RUNS_REALISTIC] [RUNS_HARSH] [HORIZON] [PLAN_BINARY]
+(defaults 1000, 100, horizon 1, target/release/examples/plan; build it
+first with `cargo build --release --example plan`). HORIZON is `--horizon`
+of the planned guidances (`all` for every remaining track). The nominal world has no random
 key: its flights are all the same, one is flown."""
 import json, os, subprocess, sys
 R = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
 H = int(sys.argv[2]) if len(sys.argv) > 2 else 100
-B = sys.argv[3] if len(sys.argv) > 3 else 'target/release/examples/plan'
+K = sys.argv[3] if len(sys.argv) > 3 else '1'
+B = sys.argv[4] if len(sys.argv) > 4 else 'target/release/examples/plan'
 ROOT = os.path.join(os.path.dirname(__file__), '..')
 D = os.path.join(ROOT, 'data', 'bathymetry')
 W = os.path.join(ROOT, 'examples', 'plan', 'fly', 'worlds')
@@ -17,7 +19,7 @@ cases = {'us_monterey_canyon_1': (80, 60, 'deep'), 'us_monterey_canyon_2': (80, 
          'es_medes_islands_2': (5, 3, 'shallow'), 'jp_aburatsubo_sagami_1': (2, 1, 'shallow')}
 only = os.environ.get('FLOWN_ONLY')
 for sev, runs in (('nominal', 1), ('realistic', R), ('harsh', H)):
-    print(f'\n#### {sev} world ({runs} flight{"s" if runs > 1 else ""} per profile)\n')
+    print(f'\n#### {sev} world ({runs} flight{"s" if runs > 1 else ""} per profile, --horizon {K})\n')
     print('| profile | guidance | collisions | below h_a | worst min alt (m) | mean alt (m) | RMS vs h_r (m) | time below h_a (s/flight) | bottom lock |')
     print('|---|---|---|---|---|---|---|---|---|')
     for p, (hr, ha, kind) in cases.items():
@@ -28,6 +30,8 @@ for sev, runs in (('nominal', 1), ('realistic', R), ('harsh', H)):
         open(cfg, 'w').write(f'reference_altitude = {hr}\nmin_altitude = {ha}\n{declared}')
         cmd = [B, 'fly', '--profile', f'{D}/{p}.csv', '--waypoints', f'{D}/{p}.waypoints.csv',
                '--config', cfg, '--runs', str(runs), '--seed', '1', '--json']
+        if K != 'all':
+            cmd += ['--horizon', K]
         if sev != 'nominal':
             cmd += ['--world', os.path.join(W, f'{kind}_{sev}.toml')]
         r = subprocess.run(cmd, capture_output=True, text=True)

@@ -25,7 +25,11 @@ fn tool() -> PathBuf {
     let p = dir
         .join("examples")
         .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
-    assert!(p.exists(), "{} not built: run `cargo build --examples`", p.display());
+    assert!(
+        p.exists(),
+        "{} not built: run `cargo build --examples`",
+        p.display()
+    );
     p
 }
 
@@ -64,7 +68,9 @@ fn profile(name: &str) -> (String, String) {
     let d = root().join("data").join("bathymetry");
     (
         d.join(format!("{name}.csv")).display().to_string(),
-        d.join(format!("{name}.waypoints.csv")).display().to_string(),
+        d.join(format!("{name}.waypoints.csv"))
+            .display()
+            .to_string(),
     )
 }
 
@@ -102,18 +108,37 @@ fn same_seed_same_numbers_on_any_thread_count() {
     let cfg = config(5.0, 3.0, "shallow");
     let wld = world("shallow_realistic");
     let args = [
-        "--profile", &p, "--waypoints", &w, "--config", &cfg, "--world", &wld,
-        "--guidance", "horizon,bottom-follow,min-altitude,constant", "--runs", "6",
-        "--seed", "7", "--json",
+        "--profile",
+        &p,
+        "--waypoints",
+        &w,
+        "--config",
+        &cfg,
+        "--world",
+        &wld,
+        "--guidance",
+        "horizon,bottom-follow,min-altitude,constant",
+        "--runs",
+        "6",
+        "--seed",
+        "7",
+        "--json",
     ];
     let one = run_env(&args, Some("1"));
     let two = run_env(&args, Some("2"));
-    assert!(one.status.success(), "{}", String::from_utf8_lossy(&one.stderr));
+    assert!(
+        one.status.success(),
+        "{}",
+        String::from_utf8_lossy(&one.stderr)
+    );
     assert_eq!(one.stdout, two.stdout, "thread count changed the numbers");
     let mut other = args;
     other[args.len() - 2] = "8";
     let three = run_env(&other, Some("2"));
-    assert_ne!(one.stdout, three.stdout, "another seed gave the same flights");
+    assert_ne!(
+        one.stdout, three.stdout,
+        "another seed gave the same flights"
+    );
     let j: Value = serde_json::from_slice(&one.stdout).unwrap();
     assert_eq!(j["runs"], 6);
     assert_eq!(j["seed"], 7);
@@ -134,14 +159,26 @@ fn nominal_world_flies_the_planners_predictions() {
     assert_eq!(flown.len(), 5);
     for (t, (f, p)) in flown.iter().zip(predicted).enumerate() {
         let (f, p) = (f.as_f64().unwrap(), p.as_f64().unwrap());
-        assert!((f - p).abs() < 2e-3, "track {}: flown {f} m, predicted {p} m", t + 1);
+        assert!(
+            (f - p).abs() < 2e-3,
+            "track {}: flown {f} m, predicted {p} m",
+            t + 1
+        );
     }
     // And the same altitudes as the planning tool's own plan of the line.
     let out = Command::new(tool()).arg("--json").output().unwrap();
     let plan: Value = serde_json::from_slice(&out.stdout).unwrap();
-    for (t, (f, tr)) in flown.iter().zip(plan["tracks"].as_array().unwrap()).enumerate() {
+    for (t, (f, tr)) in flown
+        .iter()
+        .zip(plan["tracks"].as_array().unwrap())
+        .enumerate()
+    {
         let (f, m) = (f.as_f64().unwrap(), tr["min_altitude"].as_f64().unwrap());
-        assert!((f - m).abs() < 2e-3, "track {}: flown {f} m, plan {m} m", t + 1);
+        assert!(
+            (f - m).abs() < 2e-3,
+            "track {}: flown {f} m, plan {m} m",
+            t + 1
+        );
     }
     assert_eq!(g["below_min_altitude"], 0);
 }
@@ -170,14 +207,25 @@ fn bottom_follower_holds_the_altitude_on_gentle_terrain() {
         prof += &format!("{x},{:.3}\n", 500.0 - rise);
     }
     let p = tmp("gentle.csv", &prof);
-    let w = tmp("gentle.wp.csv", "wp,x_m\n0,0\n1,1000\n2,2000\n3,3000\n4,4000\n");
+    let w = tmp(
+        "gentle.wp.csv",
+        "wp,x_m\n0,0\n1,1000\n2,2000\n3,3000\n4,4000\n",
+    );
     let j = json(&[
-        "--profile", p.to_str().unwrap(), "--waypoints", w.to_str().unwrap(),
-        "--guidance", "bottom-follow", "--json",
+        "--profile",
+        p.to_str().unwrap(),
+        "--waypoints",
+        w.to_str().unwrap(),
+        "--guidance",
+        "bottom-follow",
+        "--json",
     ]);
     let bf = guidance(&j, "bottom-follow");
     assert_eq!(bf["bottom_lock_fraction"].as_f64().unwrap(), 1.0);
-    assert!(bf["mean_rms_altitude_error"].as_f64().unwrap() < 3.0, "{bf}");
+    assert!(
+        bf["mean_rms_altitude_error"].as_f64().unwrap() < 3.0,
+        "{bf}"
+    );
     assert!(bf["worst_min_altitude"].as_f64().unwrap() > 70.0, "{bf}");
 }
 
@@ -194,8 +242,19 @@ fn certified_stays_above_h_a_in_the_realistic_world() {
         let cfg = config(h_r, h_a, kind);
         let wld = world(&format!("{kind}_realistic"));
         let j = json(&[
-            "--profile", &p, "--waypoints", &w, "--config", &cfg, "--world", &wld,
-            "--guidance", "certified", "--runs", runs, "--json",
+            "--profile",
+            &p,
+            "--waypoints",
+            &w,
+            "--config",
+            &cfg,
+            "--world",
+            &wld,
+            "--guidance",
+            "certified",
+            "--runs",
+            runs,
+            "--json",
         ]);
         let c = guidance(&j, "certified");
         assert_eq!(c["collisions"], 0, "{name}: {c}");
@@ -222,7 +281,13 @@ fn every_guidance_on_every_shared_profile() {
             &format!("reference_altitude = {h_r}\nmin_altitude = {h_a}\n"),
         );
         let j = json(&[
-            "--profile", &p, "--waypoints", &w, "--config", cfg.to_str().unwrap(), "--json",
+            "--profile",
+            &p,
+            "--waypoints",
+            &w,
+            "--config",
+            cfg.to_str().unwrap(),
+            "--json",
         ]);
         assert_eq!(j["runs"], 1);
         let names: Vec<&str> = j["guidance"]
@@ -233,12 +298,24 @@ fn every_guidance_on_every_shared_profile() {
             .collect();
         assert_eq!(
             names,
-            ["horizon", "certified", "track", "bottom-follow", "min-altitude", "constant"]
+            [
+                "horizon",
+                "certified",
+                "track",
+                "bottom-follow",
+                "min-altitude",
+                "constant"
+            ]
         );
         for g in j["guidance"].as_array().unwrap() {
             for key in [
-                "flights", "collisions", "below_min_altitude", "worst_min_altitude",
-                "mean_rms_altitude_error", "mean_altitude", "time_below_min_altitude_s",
+                "flights",
+                "collisions",
+                "below_min_altitude",
+                "worst_min_altitude",
+                "mean_rms_altitude_error",
+                "mean_altitude",
+                "time_below_min_altitude_s",
                 "bottom_lock_fraction",
             ] {
                 assert!(g.get(key).is_some(), "{name}: {} lacks {key}", g["name"]);

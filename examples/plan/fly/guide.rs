@@ -6,7 +6,7 @@
 //! speed, flight-path offset and current in the kinematics.
 
 use auvnav::{
-    AutopilotState, Measurement, Plan, PlanError, Plant, Planner, PlannerConfig, Scenario,
+    AutopilotState, Measurement, Plan, PlanError, Planner, PlannerConfig, Plant, Scenario,
     TransferFunction, VehicleState,
 };
 
@@ -100,6 +100,8 @@ pub struct Record {
 pub fn true_plant(line: &Line<'_>, gain: f64, time: f64) -> Result<Plant<ORDER>, String> {
     let v = line.nominal.vehicle();
     let tf = v.plant().transfer_function();
+    // Exactly the model: the vehicle's own plant, bit for bit.
+    #[allow(clippy::float_cmp)]
     if gain == 1.0 && time == 1.0 {
         return Ok(*v.plant());
     }
@@ -112,9 +114,9 @@ pub fn true_plant(line: &Line<'_>, gain: f64, time: f64) -> Result<Plant<ORDER>,
     for k in 1..=n {
         d.push(den[k - 1] / tau.powi(k as i32));
     }
-    for i in 0..n {
+    for (i, &b) in num.iter().enumerate().take(n) {
         // power s^{n-1-i} -> tau^{n-1-i} / tau^n
-        m.push(gain as f32 * num[i] / tau.powi(i as i32 + 1));
+        m.push(gain as f32 * b / tau.powi(i as i32 + 1));
     }
     let tf = TransferFunction::<ORDER>::pitch(&m, &d).map_err(|e| format!("true plant: {e}"))?;
     Plant::new(tf, v.sample_time()).map_err(|e| format!("true plant: {e}"))
@@ -152,7 +154,11 @@ pub fn fly(
     keep_path: bool,
 ) -> Result<Record, String> {
     let vehicle = line.nominal.vehicle();
-    let plant = true_plant(line, world.v["plant_gain_scale"], world.v["plant_time_scale"])?;
+    let plant = true_plant(
+        line,
+        world.v["plant_gain_scale"],
+        world.v["plant_time_scale"],
+    )?;
     let ap_law = vehicle.autopilot();
     let ts = f64::from(vehicle.sample_time());
     let (h_r, h_a) = (
@@ -162,14 +168,26 @@ pub fn fly(
     let u = f64::from(vehicle.speed()) * (1.0 + world.v["speed_error"]);
     let alpha = world.v["flight_path_offset"].to_radians();
     let lag = world.v["actuator_lag"];
-    let lag_a = if lag > 0.0 { 1.0 - (-ts / lag).exp() } else { 1.0 };
+    let lag_a = if lag > 0.0 {
+        1.0 - (-ts / lag).exp()
+    } else {
+        1.0
+    };
     let rate = world.v["elevator_rate_limit"] * ts;
     let mut rng = Rng::new(noise_seed.0, noise_seed.1);
     let d0 = f64::from(line.initial_depth);
     let x0 = line.wp[0];
     let x_end = *line.wp.last().unwrap_or(&x0);
     let tracks = line.wp.len() - 1;
-    let mut b = Body { eta: [0.0; ORDER], elevator: 0.0, x: x0, x_prev: x0, d: d0, d_prev: d0, t: 0.0 };
+    let mut b = Body {
+        eta: [0.0; ORDER],
+        elevator: 0.0,
+        x: x0,
+        x_prev: x0,
+        d: d0,
+        d_prev: d0,
+        t: 0.0,
+    };
     let mut ap = AutopilotState::trimmed(line.initial_depth);
     let mut g = State {
         reference: line.initial_depth,
@@ -210,7 +228,12 @@ pub fn fly(
         let n = line.wp.partition_point(|&w| w <= xi).clamp(1, tracks) - 1;
         if n != track {
             track = n;
-            let meas = Measurement { x: xi as f32, depth: m_depth as f32, pitch: m_pitch as f32, pitch_rate: m_q as f32 };
+            let meas = Measurement {
+                x: xi as f32,
+                depth: m_depth as f32,
+                pitch: m_pitch as f32,
+                pitch_rate: m_q as f32,
+            };
             on_waypoint(line, kind, &mut g, &mut rec, n, &meas, &ap, &b, world)?;
         }
         let ping = if kind.sonar() {
@@ -221,9 +244,19 @@ pub fn fly(
         } else {
             None
         };
-        let r = step_reference(line, kind, &mut g, n, m_depth, m_pitch, ping.as_ref(), ts, world);
+        let r = step_reference(
+            line,
+            kind,
+            &mut g,
+            n,
+            m_depth,
+            m_pitch,
+            ping.as_ref(),
+            ts,
+            world,
+        );
         let cmd = ap_law.update(&mut ap, r, m_depth as f32, m_pitch as f32, m_q as f32);
-        b.elevator = if lag_a == 1.0 && rate == 0.0 {
+        b.elevator = if lag <= 0.0 && rate <= 0.0 {
             cmd.elevator
         } else {
             let mut change = lag_a as f32 * (cmd.elevator - b.elevator);
@@ -235,7 +268,10 @@ pub fn fly(
         let next = plant.step(&b.eta, b.elevator);
         let mean = 0.5 * (theta + f64::from(plant.pitch(&next)));
         let mean = mean.to_radians() - alpha;
-        let (d_new, x_new) = (b.d - u * ts * mean.sin() + world.current(b.t) * ts, b.x + u * ts * mean.cos());
+        let (d_new, x_new) = (
+            b.d - u * ts * mean.sin() + world.current(b.t) * ts,
+            b.x + u * ts * mean.cos(),
+        );
         segment(&mut rec, line, world, (b.x, b.d), (x_new, d_new));
         (b.d_prev, b.x_prev, b.d, b.x, b.eta) = (b.d, b.x, d_new, x_new, next);
         b.t += ts;
@@ -303,7 +339,11 @@ fn on_waypoint(
         Kind::Constant => g.reference = line.constant,
         Kind::BottomFollow => {}
         Kind::Horizon | Kind::Certified => {
-            let sc = if kind == Kind::Horizon { &line.nominal } else { &line.declared };
+            let sc = if kind == Kind::Horizon {
+                &line.nominal
+            } else {
+                &line.declared
+            };
             let est = VehicleState::measured(&g.prior, meas)
                 .and_then(|s| s.with_integrals(ap.depth_integral, ap.pitch_integral))
                 .map_err(|e| format!("estimate: {e}"))?;
@@ -313,7 +353,8 @@ fn on_waypoint(
                     g.reference = p.depth;
                     g.prior = p.next_state;
                     rec.predicted[n] = Some(f64::from(p.min_altitude));
-                    rec.est.push(estimator_error(sc, &p, &est, meas, b, world, ap)?);
+                    rec.est
+                        .push(estimator_error(sc, &p, &est, meas, b, world, ap)?);
                 }
                 // Below the bottom by the map: climb to the shallowest depth.
                 Err(PlanError::StartBelowBottom) => {
@@ -347,7 +388,11 @@ fn estimator_error(
         ap.depth_integral,
         ap.pitch_integral,
     );
-    let n = sc.waypoints().positions().partition_point(|&w| w <= meas.x).saturating_sub(1);
+    let n = sc
+        .waypoints()
+        .positions()
+        .partition_point(|&w| w <= meas.x)
+        .saturating_sub(1);
     let predict = |s: &VehicleState<ORDER>| {
         let mut score = [auvnav::TrackScore::default()];
         sc.simulate(s, n, &[p.depth], &mut score, |_| {})
@@ -376,7 +421,10 @@ fn step_reference(
     world: &Flight,
 ) -> f32 {
     let mission = line.nominal.mission();
-    let (h_r, h_a) = (f64::from(mission.reference_altitude()), f64::from(mission.min_altitude()));
+    let (h_r, h_a) = (
+        f64::from(mission.reference_altitude()),
+        f64::from(mission.min_altitude()),
+    );
     let shallow = f64::from(mission.depth_limits()[0]);
     match (kind, ping) {
         // MOOS-IvP BHV_MinAltitudeX (ivp/src/lib_behaviors-marine/

@@ -66,7 +66,10 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
         plot: None,
     };
     while let Some(flag) = it.next() {
-        let mut value = || it.next().ok_or_else(|| Fail::usage(format!("{flag} needs a value")));
+        let mut value = || {
+            it.next()
+                .ok_or_else(|| Fail::usage(format!("{flag} needs a value")))
+        };
         match flag.as_str() {
             "--help" | "-h" => return Err(Fail::Help),
             "--profile" => a.profile = Some(value()?.into()),
@@ -97,7 +100,11 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
                     _ => return Err(Fail::usage(format!("{flag} must be at least 1"))),
                 }
             }
-            f => return Err(Fail::usage(format!("fly: unknown option `{f}` (see plan fly --help)"))),
+            f => {
+                return Err(Fail::usage(format!(
+                    "fly: unknown option `{f}` (see plan fly --help)"
+                )));
+            }
         }
     }
     if a.profile.is_some() != a.waypoints.is_some() {
@@ -140,7 +147,8 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
     };
     let (px, pb) = input::profile(&profile_text, &profile_name)?;
     let profile = Box::new(
-        Profile::<SAMPLES>::new(&px, &pb).map_err(|e| Fail::input(format!("{profile_name}: {e}")))?,
+        Profile::<SAMPLES>::new(&px, &pb)
+            .map_err(|e| Fail::input(format!("{profile_name}: {e}")))?,
     );
     let wx = input::waypoints(&wp_text, &wp_name)?;
     let waypoints =
@@ -164,10 +172,17 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
     let fail = |e: auvnav::SimError| Fail::input(format!("{wp_name}: {e}"));
     let nominal_mission = cfg.mission.with_uncertainty(Uncertainty::NONE);
     let nominal = Scenario::new(&vehicle, &*profile, &waypoints, nominal_mission).map_err(fail)?;
-    let declared_sc = Scenario::new(&vehicle, &*profile, &waypoints, cfg.mission.with_uncertainty(declared))
-        .and_then(|s| s.with_certification_bottom(envelope.view()))
-        .map_err(fail)?;
-    let initial_depth = cfg.initial_depth.unwrap_or_else(|| nominal.default_initial_depth());
+    let declared_sc = Scenario::new(
+        &vehicle,
+        &*profile,
+        &waypoints,
+        cfg.mission.with_uncertainty(declared),
+    )
+    .and_then(|s| s.with_certification_bottom(envelope.view()))
+    .map_err(fail)?;
+    let initial_depth = cfg
+        .initial_depth
+        .unwrap_or_else(|| nominal.default_initial_depth());
     let planner = PlannerConfig {
         mode: Mode::Horizon,
         horizon: a.horizon.unwrap_or(usize::MAX),
@@ -194,15 +209,27 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
             .guidance
             .iter()
             .zip(first)
-            .map(|(&k, r)| plot::Track { name: k.name(), sonar: k.sonar(), path: &r.path })
+            .map(|(&k, r)| plot::Track {
+                name: k.name(),
+                sonar: k.sonar(),
+                path: &r.path,
+            })
             .collect();
         let title = format!(
             "{profile_name}: flight 0 of seed {} ({}), true bottom, h_a = {} m",
             a.seed,
-            a.world.as_ref().map_or("nominal world".into(), |p| p.display().to_string()),
+            a.world
+                .as_ref()
+                .map_or("nominal world".into(), |p| p.display().to_string()),
             line.nominal.mission().min_altitude()
         );
-        plot::draw(path, &title, f64::from(line.nominal.mission().min_altitude()), (&line.map.x, &line.map.b), &tracks)?;
+        plot::draw(
+            path,
+            &title,
+            f64::from(line.nominal.mission().min_altitude()),
+            (&line.map.x, &line.map.b),
+            &tracks,
+        )?;
     }
     println!("{}", report(&line, &a, &flights, a.json));
     Ok(())
@@ -212,8 +239,11 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
 /// the previous one predicts.
 fn plan_track_wise(sc: &Scenario<'_, ORDER>, pc: PlannerConfig, d0: f32) -> Result<Vec<f32>, Fail> {
     let mut planner = Box::new(
-        auvnav::Planner::<MAX_HORIZON, ORDER>::new(PlannerConfig { mode: Mode::TrackWise, ..pc })
-            .map_err(|e| Fail::input(format!("config: {e}")))?,
+        auvnav::Planner::<MAX_HORIZON, ORDER>::new(PlannerConfig {
+            mode: Mode::TrackWise,
+            ..pc
+        })
+        .map_err(|e| Fail::input(format!("config: {e}")))?,
     );
     let mut state = sc.start_state(d0);
     let mut depths = Vec::new();
@@ -237,7 +267,8 @@ fn deepest_constant(sc: &Scenario<'_, ORDER>, d0: f32) -> Result<f32, Fail> {
     let h_a = sc.mission().min_altitude();
     let safe = |z: f32| {
         let mut s = vec![TrackScore::default(); tracks];
-        sc.simulate(&start, 0, &vec![z; tracks], &mut s, |_| {}).is_ok()
+        sc.simulate(&start, 0, &vec![z; tracks], &mut s, |_| {})
+            .is_ok()
             && s.iter().all(|t| t.min_altitude() >= h_a)
     };
     let [mut lo, hi] = sc.mission().depth_limits();
@@ -271,7 +302,11 @@ fn fly_all(line: &Line<'_>, spec: &WorldSpec, a: &Args) -> Result<Vec<Vec<Record
                 .map_err(|e| format!("flight {i}: {e}"));
             let n = done.fetch_add(1, Ordering::Relaxed) + 1;
             if t0.elapsed().as_secs_f64() > 1.0 {
-                eprint!("\rflown {n}/{} ({:.0} s)", a.runs, t0.elapsed().as_secs_f64());
+                eprint!(
+                    "\rflown {n}/{} ({:.0} s)",
+                    a.runs,
+                    t0.elapsed().as_secs_f64()
+                );
             }
             recs
         })
@@ -293,7 +328,9 @@ fn report(line: &Line<'_>, a: &Args, flights: &[Vec<Record>], json: bool) -> Str
         let pings: u64 = recs.iter().map(|r| r.pings).sum();
         let est: Vec<[f64; 3]> = recs.iter().flat_map(|r| r.est.iter().copied()).collect();
         let max_abs = |k: usize| est.iter().map(|e| e[k].abs()).fold(0.0, f64::max);
-        let rms = |k: usize| (est.iter().map(|e| e[k] * e[k]).sum::<f64>() / est.len().max(1) as f64).sqrt();
+        let rms = |k: usize| {
+            (est.iter().map(|e| e[k] * e[k]).sum::<f64>() / est.len().max(1) as f64).sqrt()
+        };
         let first = recs.first();
         rows.push(serde_json::json!({
             "name": kind.name(),
@@ -329,20 +366,33 @@ fn report(line: &Line<'_>, a: &Args, flights: &[Vec<Record>], json: bool) -> Str
     }
     let mut s = format!(
         "{} flights, seed {}; h_r {} m, h_a {} m; constant depth {:.1} m\n{:<14} {:>6} {:>6} {:>8} {:>8} {:>8} {:>8} {:>8}\n",
-        a.runs, a.seed,
-        line.nominal.mission().reference_altitude(), h_a, line.constant,
-        "guidance", "coll", "<h_a", "worst", "RMS", "mean", "t<h_a", "lock"
+        a.runs,
+        a.seed,
+        line.nominal.mission().reference_altitude(),
+        h_a,
+        line.constant,
+        "guidance",
+        "coll",
+        "<h_a",
+        "worst",
+        "RMS",
+        "mean",
+        "t<h_a",
+        "lock"
     );
     for r in &rows {
         s += &format!(
             "{:<14} {:>6} {:>6} {:>8.2} {:>8.2} {:>8.2} {:>8.1} {:>8}\n",
             r["name"].as_str().unwrap_or(""),
-            r["collisions"], r["below_min_altitude"],
+            r["collisions"],
+            r["below_min_altitude"],
             r["worst_min_altitude"].as_f64().unwrap_or(f64::NAN),
             r["mean_rms_altitude_error"].as_f64().unwrap_or(f64::NAN),
             r["mean_altitude"].as_f64().unwrap_or(f64::NAN),
             r["time_below_min_altitude_s"].as_f64().unwrap_or(f64::NAN),
-            r["bottom_lock_fraction"].as_f64().map_or("-".into(), |v| format!("{v:.3}")),
+            r["bottom_lock_fraction"]
+                .as_f64()
+                .map_or("-".into(), |v| format!("{v:.3}")),
         );
     }
     s.trim_end().to_string()

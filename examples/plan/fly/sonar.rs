@@ -39,7 +39,14 @@ fn slope(world: &Flight, map: &Map, x: f64) -> f64 {
 
 /// The beam from `(x, d)` at `phi` (rad) from the vertical, forward
 /// positive: slant range, hit `(x, depth)` and grazing angle (rad).
-fn cast(world: &Flight, map: &Map, x: f64, d: f64, phi: f64, max: f64) -> Option<(f64, f64, f64, f64)> {
+fn cast(
+    world: &Flight,
+    map: &Map,
+    x: f64,
+    d: f64,
+    phi: f64,
+    max: f64,
+) -> Option<(f64, f64, f64, f64)> {
     let (sx, sz) = (phi.sin(), phi.cos());
     let mut r = 0.0;
     while r <= max {
@@ -68,14 +75,14 @@ pub fn ping(world: &Flight, map: &Map, rng: &mut Rng, x: f64, d: f64, theta_deg:
     let mut fore = None;
     // Fore and aft, in the pitch plane (nose up tilts both aft).
     for (phi, is_fore) in [(j - th, true), (-j - th, false)] {
-        if let Some((r, hx, hz, g)) = cast(world, map, x, d, phi, max) {
-            if g >= min_graze {
-                let r = r + noise * rng.normal();
-                n += 1;
-                alt += r * phi.cos();
-                if is_fore {
-                    fore = Some((hx - x, hz));
-                }
+        if let Some((r, hx, hz, g)) = cast(world, map, x, d, phi, max)
+            && g >= min_graze
+        {
+            let r = r + noise * rng.normal();
+            n += 1;
+            alt += r * phi.cos();
+            if is_fore {
+                fore = Some((hx - x, hz));
             }
         }
     }

@@ -23,26 +23,66 @@ use crate::fail::Fail;
 /// and what it means. A value or a `[lo, hi]` range drawn per flight.
 pub const KEYS: &[(&str, f64, &str)] = &[
     ("speed_error", 0.0, "true speed U0 (1 + e_U), fraction"),
-    ("flight_path_offset", 0.0, "alpha, deg (flight path below pitch)"),
-    ("vertical_current", 0.0, "constant vertical current, m/s, down"),
-    ("current_amplitude", 0.0, "slowly varying current amplitude, m/s"),
+    (
+        "flight_path_offset",
+        0.0,
+        "alpha, deg (flight path below pitch)",
+    ),
+    (
+        "vertical_current",
+        0.0,
+        "constant vertical current, m/s, down",
+    ),
+    (
+        "current_amplitude",
+        0.0,
+        "slowly varying current amplitude, m/s",
+    ),
     ("current_period", 600.0, "its period, s"),
     ("plant_gain_scale", 1.0, "true plant gain / model gain"),
-    ("plant_time_scale", 1.0, "true plant time constants / model's"),
+    (
+        "plant_time_scale",
+        1.0,
+        "true plant time constants / model's",
+    ),
     ("actuator_lag", 0.0, "first-order elevator lag, s (0: none)"),
-    ("elevator_rate_limit", 0.0, "elevator rate limit, deg/s (0: none)"),
+    (
+        "elevator_rate_limit",
+        0.0,
+        "elevator rate limit, deg/s (0: none)",
+    ),
     ("depth_noise", 0.0, "depth sensor noise sigma, m"),
     ("pitch_noise", 0.0, "pitch sensor noise sigma, deg"),
-    ("pitch_rate_noise", 0.0, "pitch-rate sensor noise sigma, deg/s"),
+    (
+        "pitch_rate_noise",
+        0.0,
+        "pitch-rate sensor noise sigma, deg/s",
+    ),
     ("map_vertical_sigma", 0.0, "map vertical error sigma, m"),
-    ("map_vertical_bound", 3.0, "truncation of that error, in sigma (0: none)"),
+    (
+        "map_vertical_bound",
+        3.0,
+        "truncation of that error, in sigma (0: none)",
+    ),
     ("map_correlation_length", 200.0, "its correlation length, m"),
     ("map_horizontal_offset", 0.0, "map displaced along track, m"),
     ("nav_drift", 0.0, "navigation drift, m per m travelled"),
-    ("dvl_range", 100.0, "DVL bottom-track slant range, m (600 kHz)"),
-    ("dvl_min_grazing", 30.0, "least grazing angle a beam locks at, deg"),
+    (
+        "dvl_range",
+        100.0,
+        "DVL bottom-track slant range, m (600 kHz)",
+    ),
+    (
+        "dvl_min_grazing",
+        30.0,
+        "least grazing angle a beam locks at, deg",
+    ),
     ("dvl_noise", 0.0, "DVL range noise sigma, m"),
-    ("dvl_timeout", 10.0, "bottom follower: depth hold on lock loss, s"),
+    (
+        "dvl_timeout",
+        10.0,
+        "bottom follower: depth hold on lock loss, s",
+    ),
 ];
 
 /// A key's value: fixed or a uniform range.
@@ -87,7 +127,9 @@ impl WorldSpec {
                 toml::Value::Array(a) if a.len() == 2 => {
                     let (lo, hi) = (num(&a[0]).ok_or_else(bad)?, num(&a[1]).ok_or_else(bad)?);
                     if lo > hi {
-                        return Err(Fail::input(format!("{name}: {key} = [{lo}, {hi}]: lo > hi")));
+                        return Err(Fail::input(format!(
+                            "{name}: {key} = [{lo}, {hi}]: lo > hi"
+                        )));
                     }
                     Range(lo, hi)
                 }
@@ -103,7 +145,12 @@ impl WorldSpec {
     }
 
     fn check(&self, name: &str) -> Result<(), Fail> {
-        let positive = ["plant_gain_scale", "plant_time_scale", "current_period", "dvl_range"];
+        let positive = [
+            "plant_gain_scale",
+            "plant_time_scale",
+            "current_period",
+            "dvl_range",
+        ];
         let nonneg = [
             "actuator_lag",
             "elevator_rate_limit",
@@ -119,7 +166,10 @@ impl WorldSpec {
         ];
         for (k, r) in &self.keys {
             if (positive.contains(k) && r.0 <= 0.0) || (nonneg.contains(k) && r.0 < 0.0) {
-                return Err(Fail::input(format!("{name}: {k} = {} is out of range", r.0)));
+                return Err(Fail::input(format!(
+                    "{name}: {k} = {} is out of range",
+                    r.0
+                )));
             }
         }
         if self.keys["speed_error"].0 <= -1.0 {
@@ -132,7 +182,16 @@ impl WorldSpec {
     pub fn draw(&self, rng: &mut Rng) -> BTreeMap<&'static str, f64> {
         self.keys
             .iter()
-            .map(|(&k, &Range(lo, hi))| (k, if hi > lo { lo + (hi - lo) * rng.uniform() } else { lo }))
+            .map(|(&k, &Range(lo, hi))| {
+                (
+                    k,
+                    if hi > lo {
+                        lo + (hi - lo) * rng.uniform()
+                    } else {
+                        lo
+                    },
+                )
+            })
             .collect()
     }
 }
@@ -216,9 +275,19 @@ impl Flight {
         let n = ((x_end - x0 + 1000.0) / V_STEP).ceil() as usize + 2;
         let mut verr = vec![0.0; n];
         if sigma > 0.0 {
-            let rho = if len > 0.0 { (-V_STEP / len).exp() } else { 0.0 };
+            let rho = if len > 0.0 {
+                (-V_STEP / len).exp()
+            } else {
+                0.0
+            };
             let kick = sigma * (1.0 - rho * rho).sqrt();
-            let clip = |e: f64| if bound > 0.0 { e.clamp(-bound * sigma, bound * sigma) } else { e };
+            let clip = |e: f64| {
+                if bound > 0.0 {
+                    e.clamp(-bound * sigma, bound * sigma)
+                } else {
+                    e
+                }
+            };
             let mut e = clip(sigma * rng.normal());
             for slot in &mut verr {
                 *slot = e;
