@@ -95,6 +95,17 @@ pub struct Record {
     pub path: Vec<(f64, f64, f64, bool)>,
 }
 
+impl Record {
+    fn new(tracks: usize) -> Self {
+        Self {
+            min_altitude: f64::INFINITY,
+            track_min: vec![f64::INFINITY; tracks],
+            predicted: vec![None; tracks],
+            ..Self::default()
+        }
+    }
+}
+
 /// The true vehicle's plant: the model's transfer function with the
 /// world's gain and time scales (`G_true(s) = g G(τ s)`).
 pub fn true_plant(line: &Line<'_>, gain: f64, time: f64) -> Result<Plant<ORDER>, String> {
@@ -144,6 +155,97 @@ struct Body {
     t: f64,
 }
 
+/// The true vehicle's dynamics in one world.
+struct Truth {
+    plant: Plant<ORDER>,
+    ts: f64,
+    /// True speed, m/s; flight-path offset, rad.
+    u: f64,
+    alpha: f64,
+    /// Actuator lag, s, its per-step gain, and the rate limit per step, deg.
+    lag: f64,
+    lag_a: f64,
+    rate: f64,
+}
+
+impl Truth {
+    fn new(line: &Line<'_>, world: &Flight) -> Result<Self, String> {
+        let vehicle = line.nominal.vehicle();
+        let ts = f64::from(vehicle.sample_time());
+        let lag = world.v["actuator_lag"];
+        Ok(Self {
+            plant: true_plant(
+                line,
+                world.v["plant_gain_scale"],
+                world.v["plant_time_scale"],
+            )?,
+            ts,
+            u: f64::from(vehicle.speed()) * (1.0 + world.v["speed_error"]),
+            alpha: world.v["flight_path_offset"].to_radians(),
+            lag,
+            lag_a: if lag > 0.0 {
+                1.0 - (-ts / lag).exp()
+            } else {
+                1.0
+            },
+            rate: world.v["elevator_rate_limit"] * ts,
+        })
+    }
+
+    /// The true pitch (deg) and the measured depth (m), pitch (deg) and
+    /// pitch rate (deg/s).
+    fn measure(&self, b: &Body, world: &Flight, rng: &mut Rng) -> (f64, f64, f64, f64) {
+        let theta = f64::from(self.plant.pitch(&b.eta));
+        let q = f64::from(self.plant.pitch_rate(&b.eta));
+        let m_depth = b.d + world.v["depth_noise"] * rng.normal();
+        let m_pitch = theta + world.v["pitch_noise"] * rng.normal();
+        let m_q = q + world.v["pitch_rate_noise"] * rng.normal();
+        (theta, m_depth, m_pitch, m_q)
+    }
+
+    /// One step: the commanded elevator through the actuator, the plant,
+    /// and the kinematics along the mean pitch less the flight-path offset.
+    fn step(&self, b: &mut Body, commanded: f32, world: &Flight) -> (f64, f64) {
+        b.elevator = if self.lag <= 0.0 && self.rate <= 0.0 {
+            commanded
+        } else {
+            let mut change = self.lag_a as f32 * (commanded - b.elevator);
+            if self.rate > 0.0 {
+                change = change.clamp(-self.rate as f32, self.rate as f32);
+            }
+            b.elevator + change
+        };
+        let next = self.plant.step(&b.eta, b.elevator);
+        let theta = f64::from(self.plant.pitch(&b.eta));
+        let mean = (0.5 * (theta + f64::from(self.plant.pitch(&next)))).to_radians() - self.alpha;
+        let (ts, u) = (self.ts, self.u);
+        let (d_new, x_new) = (
+            b.d - u * ts * mean.sin() + world.current(b.t) * ts,
+            b.x + u * ts * mean.cos(),
+        );
+        let from = (b.x, b.d);
+        (b.d_prev, b.x_prev, b.d, b.x, b.eta) = (b.d, b.x, d_new, x_new, next);
+        b.t += ts;
+        from
+    }
+}
+
+/// The guidance's state at the start of the line.
+fn start(line: &Line<'_>, kind: Kind) -> Result<State, String> {
+    Ok(State {
+        reference: line.initial_depth,
+        planner: match kind {
+            Kind::Horizon | Kind::Certified => Some(Box::new(
+                Planner::new(line.planner).map_err(|e| format!("planner: {e}"))?,
+            )),
+            _ => None,
+        },
+        prior: line.nominal.start_state(line.initial_depth),
+        unlocked: 0.0,
+        unsafe_climb: false,
+    })
+}
+
 /// Flies one guidance through one world. `noise_seed` seeds the sensors
 /// (the same for every guidance of a flight: paired comparisons).
 pub fn fly(
@@ -153,30 +255,15 @@ pub fn fly(
     noise_seed: (u64, u64),
     keep_path: bool,
 ) -> Result<Record, String> {
-    let vehicle = line.nominal.vehicle();
-    let plant = true_plant(
-        line,
-        world.v["plant_gain_scale"],
-        world.v["plant_time_scale"],
-    )?;
-    let ap_law = vehicle.autopilot();
-    let ts = f64::from(vehicle.sample_time());
+    let truth = Truth::new(line, world)?;
+    let ap_law = line.nominal.vehicle().autopilot();
+    let mission = line.nominal.mission();
     let (h_r, h_a) = (
-        f64::from(line.nominal.mission().reference_altitude()),
-        f64::from(line.nominal.mission().min_altitude()),
+        f64::from(mission.reference_altitude()),
+        f64::from(mission.min_altitude()),
     );
-    let u = f64::from(vehicle.speed()) * (1.0 + world.v["speed_error"]);
-    let alpha = world.v["flight_path_offset"].to_radians();
-    let lag = world.v["actuator_lag"];
-    let lag_a = if lag > 0.0 {
-        1.0 - (-ts / lag).exp()
-    } else {
-        1.0
-    };
-    let rate = world.v["elevator_rate_limit"] * ts;
     let mut rng = Rng::new(noise_seed.0, noise_seed.1);
-    let d0 = f64::from(line.initial_depth);
-    let x0 = line.wp[0];
+    let (d0, x0) = (f64::from(line.initial_depth), line.wp[0]);
     let x_end = *line.wp.last().unwrap_or(&x0);
     let tracks = line.wp.len() - 1;
     let mut b = Body {
@@ -189,41 +276,20 @@ pub fn fly(
         t: 0.0,
     };
     let mut ap = AutopilotState::trimmed(line.initial_depth);
-    let mut g = State {
-        reference: line.initial_depth,
-        planner: match kind {
-            Kind::Horizon | Kind::Certified => Some(Box::new(
-                Planner::new(line.planner).map_err(|e| format!("planner: {e}"))?,
-            )),
-            _ => None,
-        },
-        prior: line.nominal.start_state(line.initial_depth),
-        unlocked: 0.0,
-        unsafe_climb: false,
-    };
-    let mut rec = Record {
-        min_altitude: f64::INFINITY,
-        track_min: vec![f64::INFINITY; tracks],
-        predicted: vec![None; tracks],
-        ..Record::default()
-    };
+    let mut g = start(line, kind)?;
+    let mut rec = Record::new(tracks);
     let mut track = usize::MAX;
-    let budget = (20.0 * (x_end - x0) / (u * ts)) as u64 + 10_000;
-    let mut steps = 0;
-    loop {
+    let budget = (20.0 * (x_end - x0) / (truth.u * truth.ts)) as u64 + 10_000;
+    for _ in 0..budget {
         let xi = world.navigated(b.x);
-        let theta = f64::from(plant.pitch(&b.eta));
-        let q = f64::from(plant.pitch_rate(&b.eta));
-        let m_depth = b.d + world.v["depth_noise"] * rng.normal();
-        let m_pitch = theta + world.v["pitch_noise"] * rng.normal();
-        let m_q = q + world.v["pitch_rate_noise"] * rng.normal();
+        let (theta, m_depth, m_pitch, m_q) = truth.measure(&b, world, &mut rng);
         let alt = world.bottom(&line.map, b.x) - b.d;
         if alt < rec.min_altitude {
             rec.min_at = b.x;
         }
         score(&mut rec, alt, h_r, h_a);
         if xi >= x_end || rec.collided {
-            break;
+            return Ok(rec);
         }
         let n = line.wp.partition_point(|&w| w <= xi).clamp(1, tracks) - 1;
         if n != track {
@@ -236,14 +302,13 @@ pub fn fly(
             };
             on_waypoint(line, kind, &mut g, &mut rec, n, &meas, &ap, &b, world)?;
         }
-        let ping = if kind.sonar() {
-            let p = sonar::ping(world, &line.map, &mut rng, b.x, b.d, theta);
+        let ping = kind
+            .sonar()
+            .then(|| sonar::ping(world, &line.map, &mut rng, b.x, b.d, theta));
+        if let Some(p) = &ping {
             rec.lock_steps += u64::from(p.lock);
             rec.pings += 1;
-            Some(p)
-        } else {
-            None
-        };
+        }
         let r = step_reference(
             line,
             kind,
@@ -252,39 +317,18 @@ pub fn fly(
             m_depth,
             m_pitch,
             ping.as_ref(),
-            ts,
+            truth.ts,
             world,
         );
         let cmd = ap_law.update(&mut ap, r, m_depth as f32, m_pitch as f32, m_q as f32);
-        b.elevator = if lag <= 0.0 && rate <= 0.0 {
-            cmd.elevator
-        } else {
-            let mut change = lag_a as f32 * (cmd.elevator - b.elevator);
-            if rate > 0.0 {
-                change = change.clamp(-rate as f32, rate as f32);
-            }
-            b.elevator + change
-        };
-        let next = plant.step(&b.eta, b.elevator);
-        let mean = 0.5 * (theta + f64::from(plant.pitch(&next)));
-        let mean = mean.to_radians() - alpha;
-        let (d_new, x_new) = (
-            b.d - u * ts * mean.sin() + world.current(b.t) * ts,
-            b.x + u * ts * mean.cos(),
-        );
-        segment(&mut rec, line, world, (b.x, b.d), (x_new, d_new));
-        (b.d_prev, b.x_prev, b.d, b.x, b.eta) = (b.d, b.x, d_new, x_new, next);
-        b.t += ts;
+        let from = truth.step(&mut b, cmd.elevator, world);
+        segment(&mut rec, line, world, from, (b.x, b.d));
         if keep_path {
             let bt = world.bottom(&line.map, b.x);
             rec.path.push((b.x, b.d, bt, ping.is_some_and(|p| p.lock)));
         }
-        steps += 1;
-        if steps > budget {
-            return Err("flight did not reach the end of the line".into());
-        }
     }
-    Ok(rec)
+    Err("flight did not reach the end of the line".into())
 }
 
 /// The altitude at a sample, scored.

@@ -122,35 +122,19 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
         }
         r => r?,
     };
-    let (profile_text, profile_name, wp_text, wp_name) = match (&a.profile, &a.waypoints) {
-        (Some(p), Some(w)) => (
-            input::read(p)?,
-            p.display().to_string(),
-            input::read(w)?,
-            w.display().to_string(),
-        ),
-        _ => (
-            input::BUNDLED_PROFILE.to_string(),
-            "us_monterey_canyon_1.csv (bundled)".to_string(),
-            input::BUNDLED_WAYPOINTS.to_string(),
-            "us_monterey_canyon_1.waypoints.csv (bundled)".to_string(),
-        ),
-    };
-    let config_text = match &a.config {
-        Some(p) => Some((input::read(p)?, p.display().to_string())),
-        None => None,
-    };
-    let cfg = input::config(config_text.as_ref().map(|(t, n)| (t.as_str(), n.as_str())))?;
-    let spec = match &a.world {
-        Some(p) => WorldSpec::parse(&input::read(p)?, &p.display().to_string())?,
-        None => WorldSpec::nominal(),
-    };
-    let (px, pb) = input::profile(&profile_text, &profile_name)?;
+    let Inputs {
+        cfg,
+        spec,
+        px,
+        pb,
+        wx,
+        profile_name,
+        wp_name,
+    } = load(&a)?;
     let profile = Box::new(
         Profile::<SAMPLES>::new(&px, &pb)
             .map_err(|e| Fail::input(format!("{profile_name}: {e}")))?,
     );
-    let wx = input::waypoints(&wp_text, &wp_name)?;
     let waypoints =
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
     let vehicle = Vehicle::new(&cfg.vehicle, cfg.plant).map_err(|e| Fail::input(format!("{e}")))?;
@@ -204,34 +188,98 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
         constant,
     };
     let flights = fly_all(&line, &spec, &a)?;
-    if let (Some(path), Some(first)) = (&a.plot, flights.first()) {
-        let tracks: Vec<plot::Track<'_>> = a
-            .guidance
-            .iter()
-            .zip(first)
-            .map(|(&k, r)| plot::Track {
-                name: k.name(),
-                sonar: k.sonar(),
-                path: &r.path,
-            })
-            .collect();
-        let title = format!(
-            "{profile_name}: flight 0 of seed {} ({}), true bottom, h_a = {} m",
-            a.seed,
-            a.world
-                .as_ref()
-                .map_or("nominal world".into(), |p| p.display().to_string()),
-            line.nominal.mission().min_altitude()
-        );
-        plot::draw(
-            path,
-            &title,
-            f64::from(line.nominal.mission().min_altitude()),
-            (&line.map.x, &line.map.b),
-            &tracks,
-        )?;
+    if let Some(path) = &a.plot {
+        draw(path, &line, &a, &flights, &profile_name)?;
     }
     println!("{}", report(&line, &a, &flights, a.json));
+    Ok(())
+}
+
+/// What the files say.
+struct Inputs {
+    cfg: input::Config,
+    spec: WorldSpec,
+    px: Vec<f32>,
+    pb: Vec<f32>,
+    wx: Vec<f32>,
+    profile_name: String,
+    wp_name: String,
+}
+
+/// Reads the profile, waypoints, config and world (input.rs's loaders).
+fn load(a: &Args) -> Result<Inputs, Fail> {
+    let (profile_text, profile_name, wp_text, wp_name) = match (&a.profile, &a.waypoints) {
+        (Some(p), Some(w)) => (
+            input::read(p)?,
+            p.display().to_string(),
+            input::read(w)?,
+            w.display().to_string(),
+        ),
+        _ => (
+            input::BUNDLED_PROFILE.to_string(),
+            "us_monterey_canyon_1.csv (bundled)".to_string(),
+            input::BUNDLED_WAYPOINTS.to_string(),
+            "us_monterey_canyon_1.waypoints.csv (bundled)".to_string(),
+        ),
+    };
+    let config_text = match &a.config {
+        Some(p) => Some((input::read(p)?, p.display().to_string())),
+        None => None,
+    };
+    let cfg = input::config(config_text.as_ref().map(|(t, n)| (t.as_str(), n.as_str())))?;
+    let spec = match &a.world {
+        Some(p) => WorldSpec::parse(&input::read(p)?, &p.display().to_string())?,
+        None => WorldSpec::nominal(),
+    };
+    let (px, pb) = input::profile(&profile_text, &profile_name)?;
+    let wx = input::waypoints(&wp_text, &wp_name)?;
+    Ok(Inputs {
+        cfg,
+        spec,
+        px,
+        pb,
+        wx,
+        profile_name,
+        wp_name,
+    })
+}
+
+/// `--plot`: flight 0 of each guidance.
+fn draw(
+    path: &std::path::Path,
+    line: &Line<'_>,
+    a: &Args,
+    flights: &[Vec<Record>],
+    profile_name: &str,
+) -> Result<(), Fail> {
+    let Some(first) = flights.first() else {
+        return Ok(());
+    };
+    let tracks: Vec<plot::Track<'_>> = a
+        .guidance
+        .iter()
+        .zip(first)
+        .map(|(&k, r)| plot::Track {
+            name: k.name(),
+            sonar: k.sonar(),
+            path: &r.path,
+        })
+        .collect();
+    let title = format!(
+        "{profile_name}: flight 0 of seed {} ({}), true bottom, h_a = {} m",
+        a.seed,
+        a.world
+            .as_ref()
+            .map_or("nominal world".into(), |p| p.display().to_string()),
+        line.nominal.mission().min_altitude()
+    );
+    plot::draw(
+        path,
+        &title,
+        f64::from(line.nominal.mission().min_altitude()),
+        (&line.map.x, &line.map.b),
+        &tracks,
+    )?;
     Ok(())
 }
 
