@@ -9,6 +9,7 @@
 
 mod args;
 mod fail;
+mod fly;
 mod input;
 mod map;
 mod plot;
@@ -39,6 +40,7 @@ fn main() -> ExitCode {
             argv.next();
             map::profile_command(argv)
         }
+        Some("fly") => fly::main(std::env::args().skip(2)),
         _ => run(Args::parse_os(argv)),
     };
     match result {
