@@ -32,6 +32,8 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     /// `Σ V` at the last point evaluated: the optimizers' last evaluation
     /// is always the point they return.
     pub last_violation: f32,
+    /// Least altitude over the horizon at the last point evaluated, m.
+    pub last_min_altitude: f32,
     /// With one track: the last depth evaluated, its score and end state,
     /// which the verification then need not fly again.
     pub last_flight: Option<(f32, TrackScore, VehicleState<N>)>,
@@ -65,6 +67,7 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             evaluations: 0,
             budget: u32::MAX,
             last_violation: 0.0,
+            last_min_altitude: f32::INFINITY,
             last_flight: None,
             guard: None,
             tripped: None,
@@ -102,6 +105,7 @@ impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
             *gi += *vi * self.mu;
         }
         self.last_violation = e.violation;
+        self.last_min_altitude = e.min_altitude;
         self.last_flight = match (self.count, e.scores.first(), z.first()) {
             (1, Some(s), Some(&z0)) => Some((z0, *s, e.end)),
             _ => None,
