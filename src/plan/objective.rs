@@ -76,6 +76,37 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
     }
 }
 
+impl<const N: usize> PlanObjective<'_, N> {
+    /// `Φ(ζ)` alone, by a plain flight of the horizon (no tangents): what
+    /// a scan needs. Counts as an evaluation, within the budget; leaves
+    /// the last point's records (`last_*`) alone.
+    pub fn flight_value<const K: usize>(&mut self, z: &[f32; K]) -> Result<f32, Stop> {
+        if self.tripped.is_some() {
+            return Err(Stop::LeftSafeSet);
+        }
+        if self.evaluations >= self.budget {
+            return Err(Stop::Budget);
+        }
+        self.evaluations = self.evaluations.saturating_add(1);
+        let used = z.get(..self.count).ok_or(Stop::Sim(SimError::TrackRange))?;
+        let mut scores = [TrackScore::default(); K];
+        let sc = scores
+            .get_mut(..self.count)
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        self.sc
+            .simulate(self.start, self.track, used, sc, |_| {})
+            .map_err(Stop::Sim)?;
+        let j: f32 = sc.iter().map(TrackScore::j).sum();
+        let violation: f32 = sc.iter().map(TrackScore::violation).sum();
+        let phi = j + self.mu * violation;
+        if phi.is_finite() {
+            Ok(phi)
+        } else {
+            Err(Stop::Sim(SimError::Diverged))
+        }
+    }
+}
+
 impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
     type Error = Stop;
 
@@ -111,5 +142,12 @@ impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
             _ => None,
         };
         Ok((e.j + self.mu * e.violation, g))
+    }
+
+    /// A horizon's trial values by a plain flight (a single track's
+    /// evaluation records its flight and guards the safe set: no cheaper
+    /// value there).
+    fn value(&mut self, z: &[f32; K]) -> Option<Result<f32, Stop>> {
+        (self.count > 1 && self.guard.is_none()).then(|| self.flight_value(z))
     }
 }

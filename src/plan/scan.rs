@@ -267,19 +267,40 @@ pub(super) fn scan_start<const N: usize, const K: usize>(
 }
 
 /// Paths kept by the horizon's beam scan at each track.
-const BEAM: usize = 3;
+const BEAM: usize = 4;
 
 /// One path of the beam scan: its depths so far, the objective they add
 /// up to and the state they leave.
 #[derive(Clone, Copy)]
 struct Path<const N: usize, const K: usize> {
     z: [f32; K],
+    /// Grid point of the last track scanned.
+    k: u32,
     phi: f32,
     st: VehicleState<N>,
 }
 
-/// Keeps `p` among the `BEAM` lowest-objective paths of `beam`.
+/// Keeps `p` among the `BEAM` lowest-objective paths of `beam`, sorted,
+/// at most one per grid point of the track scanned (so that the beam keeps
+/// distinct depths of it, not one depth from several parents).
 fn keep<const N: usize, const K: usize>(beam: &mut [Option<Path<N, K>>; BEAM], p: Path<N, K>) {
+    if let Some(i) = beam.iter().position(|s| s.is_some_and(|s| s.k == p.k)) {
+        if beam
+            .get(i)
+            .copied()
+            .flatten()
+            .is_some_and(|s| s.phi <= p.phi)
+        {
+            return;
+        }
+        // Drop the worse path of the same grid point, closing the gap.
+        for m in i..BEAM {
+            let after = beam.get(m.saturating_add(1)).copied().flatten();
+            if let Some(slot) = beam.get_mut(m) {
+                *slot = after;
+            }
+        }
+    }
     let mut cur = Some(p);
     for slot in beam.iter_mut() {
         match (cur, *slot) {
@@ -315,6 +336,7 @@ fn beam_scan<const N: usize, const K: usize>(
         &mut beam,
         Path {
             z: *z0,
+            k: 0,
             phi: 0.0,
             st,
         },
@@ -340,6 +362,7 @@ fn beam_scan<const N: usize, const K: usize>(
                 }
                 path.phi = parent.phi + sc.j() + spec.mu * sc.violation();
                 path.st = end;
+                path.k = k;
                 if path.phi.is_finite() {
                     keep(&mut next, path);
                 }

@@ -126,7 +126,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if let Some(zj) = z.get_mut(j) {
                 *zj = grid(lo, hi, k, self.cfg.scan_points);
             }
-            if let Ok((phi, _)) = optim::Objective::<K>::eval(obj, &z)
+            if let Ok(phi) = obj.flight_value(&z)
                 && phi < best.as_ref().map_or(out.j, |b| b.0)
             {
                 best = Some((phi, z));
