@@ -441,18 +441,6 @@ impl<const N: usize> Plant<N> {
         eta.get(1).copied().unwrap_or(0.0)
     }
 
-    /// The pitch row of `K` state columns (tangents): `C m`, deg per column.
-    #[inline(always)]
-    pub(crate) fn pitch_of<const K: usize>(&self, m: &SMatrix<f32, N, K>) -> SVector<f32, K> {
-        SVector::from_fn(|k, _| m.get((0, k)).copied().unwrap_or(0.0))
-    }
-
-    /// The pitch-rate row of `K` state columns: `C A m`, deg/s per column.
-    #[inline(always)]
-    pub(crate) fn pitch_rate_of<const K: usize>(&self, m: &SMatrix<f32, N, K>) -> SVector<f32, K> {
-        SVector::from_fn(|k, _| m.get((1, k)).copied().unwrap_or(0.0))
-    }
-
     /// [`Plant::step`] on the simulation's vector type.
     #[inline(always)]
     pub(crate) fn step_v(&self, eta: &SVector<f32, N>, elevator: f32) -> SVector<f32, N> {

@@ -16,6 +16,9 @@
 //! first step that lands deep in a stiff penalty then costs two or three
 //! evaluations instead of a dozen halvings.
 //!
+//! An objective with a cheaper value ([`Objective::value`]) has its trials
+//! tried by value alone, and the gradient evaluated at the accepted one.
+//!
 //! With projection the actual step `z_t − z` replaces `α s`, so the test
 //! stays a true sufficient-decrease test at the bound. A trial whose
 //! evaluation fails (a diverging simulation) or is not finite counts as
@@ -145,6 +148,21 @@ impl<const K: usize> LineSearch<K> for Armijo {
                 return None;
             }
             *evals = evals.saturating_add(1);
+            // A cheap value first, where the objective has one: a rejected
+            // trial then costs no gradient.
+            let cheap = match obj.value(&zt.into()) {
+                None => None,
+                Some(Ok(jt)) if jt.is_finite() && self.accepts(j, jt, slope) => {
+                    *evals = evals.saturating_add(1);
+                    None
+                }
+                Some(Ok(jt)) if jt.is_finite() => Some(jt),
+                Some(_) => Some(f32::INFINITY),
+            };
+            if let Some(jt) = cheap {
+                alpha *= self.reduction(j, jt, slope);
+                continue;
+            }
             let jt = match eval(obj, &zt) {
                 Ok((jt, gt)) if jt.is_finite() && gt.iter().all(|v| v.is_finite()) => {
                     if self.accepts(j, jt, slope) {

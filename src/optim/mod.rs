@@ -39,6 +39,18 @@ pub trait Objective<const K: usize> {
     /// When the function cannot be evaluated at `z` (for the planner: the
     /// simulation diverged).
     fn eval(&mut self, z: &[f32; K]) -> Result<(f32, [f32; K]), Self::Error>;
+
+    /// The value alone at `z`, when the objective has a cheaper way to it
+    /// than [`Objective::eval`] (for the planner: a flight without the
+    /// tangent pass); `None` (the default) when it has not. It must equal
+    /// `eval`'s value. The line search tries its trial points with it and
+    /// evaluates the gradient only at the point it accepts.
+    ///
+    /// # Errors
+    /// As [`Objective::eval`].
+    fn value(&mut self, _z: &[f32; K]) -> Option<Result<f32, Self::Error>> {
+        None
+    }
 }
 
 /// The optimizers' internal vector type; plain arrays at the boundary.

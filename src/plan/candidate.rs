@@ -17,7 +17,7 @@ use super::scan::{ScanLog, ScanSpec, scan_start, search_box};
 use super::single::{self, Decision};
 use super::solve::Merge;
 use super::status::{Found, OptimizerStop};
-use super::{Mode, PlanError, Planner};
+use super::{Method, Mode, PlanError, Planner};
 
 /// First step of a warm-started solve, relative to `first_step`.
 const WARM_FIRST_STEP: f32 = 0.1;
@@ -267,6 +267,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 h: s.h,
                 points,
                 mu: s.mu,
+                beam: self.cfg.method == Method::Bfgs,
             };
             scan_start(fl, &spec, &mut z0, &mut curvature, scan)?;
         }

@@ -4,7 +4,7 @@
 //!
 //! ```text
 //! state at X_{n-1}, waypoints, bottom ─► search box (reachable depths)
-//!   ─► start: coarse scan, track by track (or the previous call's plan)
+//!   ─► start: coarse scan, a beam over the tracks (or the previous call's plan)
 //!   ─► BFGS or GD on  Φ(ζ) = Σ J + μ Σ V          ζ = (z_n .. z_{n+h-1})
 //!   ─► verify z_n by simulation ─► safe? ─ no ─► closest safe depth, or the safest
 //!   ─► certify z_n with a continuation to the line's end in every declared world
@@ -32,7 +32,10 @@
 //! (`track_scan_points` for a constrained single track),
 //! track by track from the state the best of the previous track leaves:
 //! the search starts in the best basin found, never on a plateau that is
-//! not the best scanned value. In horizon mode later calls start from the
+//! not the best scanned value. A horizon of two tracks or more under BFGS
+//! is scanned as a beam: each track's grid from the end states of the
+//! three best paths so far (by summed `J + μ V`, one path per grid point),
+//! so that a depth which leaves a later track no safe depth loses. In horizon mode later calls start from the
 //! previous call's plan, and only the newly visible track is scanned.
 //!
 //! **Constraint, one track** (track-wise mode, and the last track of a

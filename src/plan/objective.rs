@@ -32,6 +32,8 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     /// `Σ V` at the last point evaluated: the optimizers' last evaluation
     /// is always the point they return.
     pub last_violation: f32,
+    /// Least altitude over the horizon at the last point evaluated, m.
+    pub last_min_altitude: f32,
     /// With one track: the last depth evaluated, its score and end state,
     /// which the verification then need not fly again.
     pub last_flight: Option<(f32, TrackScore, VehicleState<N>)>,
@@ -65,10 +67,42 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             evaluations: 0,
             budget: u32::MAX,
             last_violation: 0.0,
+            last_min_altitude: f32::INFINITY,
             last_flight: None,
             guard: None,
             tripped: None,
             best_safe: None,
+        }
+    }
+}
+
+impl<const N: usize> PlanObjective<'_, N> {
+    /// `Φ(ζ)` alone, by a plain flight of the horizon (no tangents): what
+    /// a scan needs. Counts as an evaluation, within the budget; leaves
+    /// the last point's records (`last_*`) alone.
+    pub fn flight_value<const K: usize>(&mut self, z: &[f32; K]) -> Result<f32, Stop> {
+        if self.tripped.is_some() {
+            return Err(Stop::LeftSafeSet);
+        }
+        if self.evaluations >= self.budget {
+            return Err(Stop::Budget);
+        }
+        self.evaluations = self.evaluations.saturating_add(1);
+        let used = z.get(..self.count).ok_or(Stop::Sim(SimError::TrackRange))?;
+        let mut scores = [TrackScore::default(); K];
+        let sc = scores
+            .get_mut(..self.count)
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        self.sc
+            .simulate(self.start, self.track, used, sc, |_| {})
+            .map_err(Stop::Sim)?;
+        let j: f32 = sc.iter().map(TrackScore::j).sum();
+        let violation: f32 = sc.iter().map(TrackScore::violation).sum();
+        let phi = j + self.mu * violation;
+        if phi.is_finite() {
+            Ok(phi)
+        } else {
+            Err(Stop::Sim(SimError::Diverged))
         }
     }
 }
@@ -102,10 +136,18 @@ impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
             *gi += *vi * self.mu;
         }
         self.last_violation = e.violation;
+        self.last_min_altitude = e.min_altitude;
         self.last_flight = match (self.count, e.scores.first(), z.first()) {
             (1, Some(s), Some(&z0)) => Some((z0, *s, e.end)),
             _ => None,
         };
         Ok((e.j + self.mu * e.violation, g))
+    }
+
+    /// A horizon's trial values by a plain flight (a single track's
+    /// evaluation records its flight and guards the safe set: no cheaper
+    /// value there).
+    fn value(&mut self, z: &[f32; K]) -> Option<Result<f32, Stop>> {
+        (self.count > 1 && self.guard.is_none()).then(|| self.flight_value(z))
     }
 }

@@ -192,6 +192,9 @@ pub(super) struct ScanSpec<'b, const K: usize> {
     pub points: u32,
     /// Penalty weight of the objective scanned.
     pub mu: f32,
+    /// Whether a horizon is scanned as a beam search (else greedily,
+    /// track by track: the paper's GD keeps its start).
+    pub beam: bool,
 }
 
 /// Coarse scan of tracks `from..h` of the horizon, each from the state
@@ -213,6 +216,9 @@ pub(super) fn scan_start<const N: usize, const K: usize>(
             Err(e) if j == 0 => return Err(e.into()),
             Err(_) => break,
         }
+    }
+    if spec.beam && spec.h.saturating_sub(spec.from) >= 2 {
+        return beam_scan(fl, spec, st, z0, log);
     }
     let n = spec.points;
     for j in spec.from..spec.h {
@@ -256,6 +262,119 @@ pub(super) fn scan_start<const N: usize, const K: usize>(
             *slot = c;
         }
         st = next;
+    }
+    Ok(())
+}
+
+/// Paths kept by the horizon's beam scan at each track.
+const BEAM: usize = 4;
+
+/// One path of the beam scan: its depths so far, the objective they add
+/// up to and the state they leave.
+#[derive(Clone, Copy)]
+struct Path<const N: usize, const K: usize> {
+    z: [f32; K],
+    /// Grid point of the last track scanned.
+    k: u32,
+    phi: f32,
+    st: VehicleState<N>,
+}
+
+/// Keeps `p` among the `BEAM` lowest-objective paths of `beam`, sorted,
+/// at most one per grid point of the track scanned (so that the beam keeps
+/// distinct depths of it, not one depth from several parents).
+fn keep<const N: usize, const K: usize>(beam: &mut [Option<Path<N, K>>; BEAM], p: Path<N, K>) {
+    if let Some(i) = beam.iter().position(|s| s.is_some_and(|s| s.k == p.k)) {
+        if beam
+            .get(i)
+            .copied()
+            .flatten()
+            .is_some_and(|s| s.phi <= p.phi)
+        {
+            return;
+        }
+        // Drop the worse path of the same grid point, closing the gap.
+        for m in i..BEAM {
+            let after = beam.get(m.saturating_add(1)).copied().flatten();
+            if let Some(slot) = beam.get_mut(m) {
+                *slot = after;
+            }
+        }
+    }
+    let mut cur = Some(p);
+    for slot in beam.iter_mut() {
+        match (cur, *slot) {
+            (Some(c), Some(s)) if c.phi < s.phi => {
+                *slot = Some(c);
+                cur = Some(s);
+            }
+            (Some(c), None) => {
+                *slot = Some(c);
+                cur = None;
+            }
+            _ => {}
+        }
+    }
+}
+
+/// Scan of a horizon (two tracks or more from `from`) as a beam search:
+/// each track's grid is flown from the end state of each of the `BEAM`
+/// best paths so far, ranked by their summed objective `Σ J + μ Σ V`, so
+/// that a depth which leaves a later track no safe depth loses to one that
+/// does (a greedy track-by-track scan cannot see that). The best path's
+/// depths start the optimizer; the first track's flights are logged.
+fn beam_scan<const N: usize, const K: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    spec: &ScanSpec<'_, K>,
+    st: VehicleState<N>,
+    z0: &mut [f32; K],
+    log: &mut ScanLog,
+) -> Result<(), PlanError> {
+    let n = spec.points;
+    let mut beam: [Option<Path<N, K>>; BEAM] = [None; BEAM];
+    keep(
+        &mut beam,
+        Path {
+            z: *z0,
+            k: 0,
+            phi: 0.0,
+            st,
+        },
+    );
+    for j in spec.from..spec.h {
+        let (lo, hi) = (
+            spec.bounds.lo.get(j).copied().unwrap_or(0.0),
+            spec.bounds.hi.get(j).copied().unwrap_or(0.0),
+        );
+        let mut next: [Option<Path<N, K>>; BEAM] = [None; BEAM];
+        for parent in beam.iter().flatten() {
+            for k in 0..n {
+                let z = grid(lo, hi, k, n);
+                let Ok((sc, end)) = fl.fly_from(&parent.st, j, z) else {
+                    continue;
+                };
+                if j == 0 {
+                    log.push(z, &sc);
+                }
+                let mut path = *parent;
+                if let Some(slot) = path.z.get_mut(j) {
+                    *slot = z;
+                }
+                path.phi = parent.phi + sc.j() + spec.mu * sc.violation();
+                path.st = end;
+                path.k = k;
+                if path.phi.is_finite() {
+                    keep(&mut next, path);
+                }
+            }
+        }
+        if next.first().is_none_or(Option::is_none) {
+            return Err(PlanError::Sim(crate::sim::SimError::Diverged));
+        }
+        beam = next;
+    }
+    if let Some(Some(best)) = beam.first() {
+        *z0 = best.z;
     }
     Ok(())
 }

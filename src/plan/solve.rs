@@ -39,7 +39,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut iterations = self.work.iterations;
         let stages = if h == 1 { 1 } else { self.cfg.penalty_stages };
         let max_mu = (1..stages).fold(self.cfg.penalty_weight, |m, _| m * PENALTY_GROWTH);
-        while obj.mu > 0.0 && obj.mu < max_mu && obj.last_violation > 0.0 && iterations < cap {
+        // Another stage only while the optimum is below the certified
+        // altitude `h_a + m_s`: a violation of the penalty altitude
+        // `h_a + m_p` alone is what the margin is there to absorb.
+        let h_safe = obj.sc.mission().min_altitude() + self.cfg.safety_margin;
+        while obj.mu > 0.0
+            && obj.mu < max_mu
+            && obj.last_violation > 0.0
+            && obj.last_min_altitude < h_safe
+            && iterations < cap
+        {
             obj.mu *= PENALTY_GROWTH;
             let from = self.work.z;
             let left = cap.saturating_sub(iterations);
@@ -117,7 +126,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if let Some(zj) = z.get_mut(j) {
                 *zj = grid(lo, hi, k, self.cfg.scan_points);
             }
-            if let Ok((phi, _)) = optim::Objective::<K>::eval(obj, &z)
+            if let Ok(phi) = obj.flight_value(&z)
                 && phi < best.as_ref().map_or(out.j, |b| b.0)
             {
                 best = Some((phi, z));

@@ -30,7 +30,7 @@
 //! clamp's edge, and it is exactly zero on the plateaus where the pitch
 //! reference stays saturated over a whole track (contract §10).
 
-use nalgebra::{SMatrix, SVector};
+use nalgebra::SVector;
 
 use crate::model::Vehicle;
 use crate::num::DEG;
@@ -38,39 +38,25 @@ use crate::num::DEG;
 use super::lin::{EndAt, PieceLin, Sensitivity, StepLin};
 use super::{Scenario, SimError, TrackScore, VehicleState};
 
-/// Tangents of the state with respect to `K` reference depths, and the
-/// accumulated gradients.
-struct Tangents<const N: usize, const K: usize> {
-    eta: SMatrix<f32, N, K>,
-    d: SVector<f32, K>,
-    d_prev: SVector<f32, K>,
-    x: SVector<f32, K>,
-    x_prev: SVector<f32, K>,
-    depth_integral: SVector<f32, K>,
-    pitch_integral: SVector<f32, K>,
-    grad_j: SVector<f32, K>,
-    grad_violation: SVector<f32, K>,
+/// The tangent of the state with respect to one reference depth, and the
+/// gradients it accumulates.
+#[derive(Clone, Copy)]
+struct Column<const N: usize> {
+    eta: SVector<f32, N>,
+    d: f32,
+    d_prev: f32,
+    x: f32,
+    x_prev: f32,
+    depth_integral: f32,
+    pitch_integral: f32,
+    grad_j: f32,
+    grad_violation: f32,
 }
 
-impl<const N: usize, const K: usize> Tangents<N, K> {
-    /// The start state does not depend on `ζ`: every tangent is zero.
-    fn zero() -> Self {
-        Self {
-            eta: SMatrix::zeros(),
-            d: SVector::zeros(),
-            d_prev: SVector::zeros(),
-            x: SVector::zeros(),
-            x_prev: SVector::zeros(),
-            depth_integral: SVector::zeros(),
-            pitch_integral: SVector::zeros(),
-            grad_j: SVector::zeros(),
-            grad_violation: SVector::zeros(),
-        }
-    }
-
+impl<const N: usize> Column<N> {
     /// `∂e` at a piece end.
     #[inline(always)]
-    fn de(&self, at: EndAt, slope_ratio: f32) -> SVector<f32, K> {
+    fn de(&self, at: EndAt, slope_ratio: f32) -> f32 {
         match at {
             EndAt::Start { slope } => self.x_prev * slope - self.d_prev,
             EndAt::End { slope } => self.x * slope - self.d,
@@ -83,11 +69,38 @@ impl<const N: usize, const K: usize> Tangents<N, K> {
 
     /// `∂x` at a piece end (zero at a fixed waypoint).
     #[inline(always)]
-    fn dx(&self, at: EndAt) -> SVector<f32, K> {
+    fn dx(&self, at: EndAt) -> f32 {
         match at {
             EndAt::Start { .. } => self.x_prev,
             EndAt::End { .. } => self.x,
-            EndAt::Clip { .. } => SVector::zeros(),
+            EndAt::Clip { .. } => 0.0,
+        }
+    }
+}
+
+/// Tangents of the state with respect to `K` reference depths, one column
+/// per depth. Depth `j`'s column is exactly zero until its track begins
+/// (the start state and the earlier tracks do not depend on it), so each
+/// step and piece updates only the columns of the tracks begun so far.
+struct Tangents<const N: usize, const K: usize> {
+    cols: [Column<N>; K],
+}
+
+impl<const N: usize, const K: usize> Tangents<N, K> {
+    /// The start state does not depend on `ζ`: every tangent is zero.
+    fn zero() -> Self {
+        Self {
+            cols: [Column {
+                eta: SVector::zeros(),
+                d: 0.0,
+                d_prev: 0.0,
+                x: 0.0,
+                x_prev: 0.0,
+                depth_integral: 0.0,
+                pitch_integral: 0.0,
+                grad_j: 0.0,
+                grad_violation: 0.0,
+            }; K],
         }
     }
 }
@@ -100,64 +113,57 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
         let cfg = ap.config();
         let ts = plant.sample_time();
         let (gd, gt) = (&cfg.depth_pid, &cfg.pitch_pid);
-
-        let pitch = plant.pitch_of(&self.eta);
-        let pitch_rate = plant.pitch_rate_of(&self.eta);
-        let mut e_d = -self.d;
-        if let Some(r) = e_d.get_mut(lin.slot) {
-            *r += 1.0;
+        let (ad, bd) = (plant.ad_m(), plant.bd_v());
+        let sign = ap.loop_sign();
+        let c = lin.command;
+        let (dd, dx) = (lin.step * lin.cos, lin.step * lin.sin);
+        for (j, col) in self
+            .cols
+            .iter_mut()
+            .enumerate()
+            .take(lin.slot.saturating_add(1))
+        {
+            let pitch = plant.pitch_v(&col.eta);
+            let pitch_rate = plant.pitch_rate_v(&col.eta);
+            let e_d = if j == lin.slot { 1.0 - col.d } else { -col.d };
+            let rate = (col.d - col.d_prev) / ts;
+            let v_ = -(e_d * gd.kp + col.depth_integral * gd.ki - rate * gd.kd);
+            let pitch_ref = if c.pitch_ref_linear { v_ } else { 0.0 };
+            let e_t = pitch_ref - pitch;
+            let w = (e_t * gt.kp + col.pitch_integral * gt.ki - pitch_rate * gt.kd) * sign;
+            let elevator = if c.elevator_linear { w } else { 0.0 };
+            if c.depth_integrating {
+                col.depth_integral += e_d * ts;
+            }
+            if c.pitch_integrating {
+                col.pitch_integral += e_t * ts;
+            }
+            col.eta = ad * col.eta + bd * elevator;
+            let pitch_next = plant.pitch_v(&col.eta);
+            let mean = (pitch + pitch_next) * (0.5 * DEG);
+            col.d_prev = col.d;
+            col.x_prev = col.x;
+            col.d -= mean * dd;
+            col.x -= mean * dx;
         }
-        let rate = (self.d - self.d_prev) / ts;
-        let v_ = -(e_d * gd.kp + self.depth_integral * gd.ki - rate * gd.kd);
-        let pitch_ref = if lin.command.pitch_ref_linear {
-            v_
-        } else {
-            SVector::zeros()
-        };
-        let e_t = pitch_ref - pitch;
-        let w = (e_t * gt.kp + self.pitch_integral * gt.ki - pitch_rate * gt.kd) * ap.loop_sign();
-        let elevator = if lin.command.elevator_linear {
-            w
-        } else {
-            SVector::zeros()
-        };
-        if lin.command.depth_integrating {
-            self.depth_integral += e_d * ts;
-        }
-        if lin.command.pitch_integrating {
-            self.pitch_integral += e_t * ts;
-        }
-        self.eta = plant.ad_m() * self.eta + plant.bd_v() * elevator.transpose();
-        let pitch_next = plant.pitch_of(&self.eta);
-        let mean = (pitch + pitch_next) * (0.5 * DEG);
-        let step = lin.step;
-        self.d_prev = self.d;
-        self.x_prev = self.x;
-        self.d -= mean * (step * lin.cos);
-        self.x -= mean * (step * lin.sin);
     }
 
     #[inline(always)]
-    fn piece(&mut self, _slot: usize, p: &PieceLin) {
+    fn piece(&mut self, slot: usize, p: &PieceLin) {
         let ratio = p.dd / p.dx;
-        let de_lo = self.de(p.lo.at, ratio);
-        let de_hi = self.de(p.hi.at, ratio);
-        let dlen = self.dx(p.hi.at) - self.dx(p.lo.at);
-        self.grad_j += dlen * (0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e))
-            + (de_lo * p.lo.e + de_hi * p.hi.e) * (0.5 * p.len);
-        // p = max(0, h_a − h) and e = h − h_r, so ∂p = −∂e where p > 0.
-        let dp_lo = if p.lo.p > 0.0 {
-            -de_lo
-        } else {
-            SVector::zeros()
-        };
-        let dp_hi = if p.hi.p > 0.0 {
-            -de_hi
-        } else {
-            SVector::zeros()
-        };
-        self.grad_violation += dlen * (0.25 * (p.lo.p * p.lo.p + p.hi.p * p.hi.p))
-            + (dp_lo * p.lo.p + dp_hi * p.hi.p) * (0.5 * p.len);
+        let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
+        let sq_p = 0.25 * (p.lo.p * p.lo.p + p.hi.p * p.hi.p);
+        let half = 0.5 * p.len;
+        for col in self.cols.iter_mut().take(slot.saturating_add(1)) {
+            let de_lo = col.de(p.lo.at, ratio);
+            let de_hi = col.de(p.hi.at, ratio);
+            let dlen = col.dx(p.hi.at) - col.dx(p.lo.at);
+            col.grad_j += dlen * sq_e + (de_lo * p.lo.e + de_hi * p.hi.e) * half;
+            // p = max(0, h_a − h) and e = h − h_r, so ∂p = −∂e where p > 0.
+            let dp_lo = if p.lo.p > 0.0 { -de_lo } else { 0.0 };
+            let dp_hi = if p.hi.p > 0.0 { -de_hi } else { 0.0 };
+            col.grad_violation += dlen * sq_p + (dp_lo * p.lo.p + dp_hi * p.hi.p) * half;
+        }
     }
 }
 
@@ -218,8 +224,9 @@ impl<const N: usize> Scenario<'_, N> {
         let mut tan = Tangents::<N, K>::zero();
         let end =
             self.run::<_, _, true>(start, first_track, used, &mut scores, &mut tan, |_| {})?;
-        let grad_j: [f32; K] = tan.grad_j.into();
-        let grad_violation: [f32; K] = tan.grad_violation.into();
+        let grad_j: [f32; K] = core::array::from_fn(|j| tan.cols.get(j).map_or(0.0, |c| c.grad_j));
+        let grad_violation: [f32; K] =
+            core::array::from_fn(|j| tan.cols.get(j).map_or(0.0, |c| c.grad_violation));
         if !grad_j.iter().chain(&grad_violation).all(|g| g.is_finite()) {
             return Err(SimError::Diverged);
         }

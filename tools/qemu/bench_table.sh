@@ -97,7 +97,9 @@ END {
     if (unit[id] == "step") lab = lab " (" group(units[id]) " steps)"
     if (unit[id] == "km") lab = lab " (" units[id] " km)"
     if (id ~ /^eval1_/) lab = lab ", track " substr(id, 7)
-    if (id ~ /^(tw|hz)_/) lab = lab ", track " substr(id, 4)
+    if (id ~ /^(tw|hz|hc)_/) lab = lab ", track " substr(id, 4)
+    if (id ~ /^hz_/) { hz_sum += net; if (id == "hz_1") hz_cold = net; else if (net > hz_later) hz_later = net }
+    if (id ~ /^hc_/) hc_sum += net
     nt = note[id]
     if (id == steep) nt = nt " **(steepest track)**"
     if (id in stack) nt = nt "; stack " group(stack[id]) " B"
@@ -115,6 +117,13 @@ END {
   printf "| track-wise solve of the steepest track (%s, %.1f deg) | %s | <= 10 000 000 |\n", "track " substr(steep, 4), steep_deg, group(count[steep] - over)
   printf "| stack high-water mark of one solve, track-wise (Planner::<1>), worst track | %s | <= 8 KiB |\n", kib(tw_stack)
   printf "| stack high-water mark of one solve, horizon (Planner::<5>), worst call | %s | <= 8 KiB |\n", hz_stack ? kib(hz_stack) : "not run"
+  if (hz_sum > 0) {
+    printf "| horizon (Planner::<5>), cold call (track 1) | %s | <= 250 000 000 |\n", group(hz_cold)
+    printf "| horizon (Planner::<5>), worst later call | %s | <= 40 000 000 |\n", group(hz_later)
+    printf "| horizon (Planner::<5>), whole line, nominal | %s | <= 400 000 000 |\n", group(hz_sum)
+  }
+  if (hc_sum > 0) printf "| horizon (Planner::<5>), whole line, certified (declared uncertainty) | %s | <= 800 000 000 |\n", group(hc_sum)
+  if (("eval5" in count) && ("step" in count)) printf "| objective+gradient K = 5 / plain flight of the line | %.2f | <= 2.5 |\n", (count["eval5"] - over) / (count["step"] - over)
   printf "| planner flash: .text + .rodata of the planner application, release (opt-level 3) | %s | <= 48 KiB |\n", kib(a_text + a_ro)
   if (l_text > 0) printf "| the same at opt-level \"s\", fat LTO, 1 codegen unit | %s | <= 48 KiB |\n", kib(l_text + l_ro)
   printf "| static RAM (.data + .bss + .uninit) of the planner application | %s | |\n", kib(a_ram)
