@@ -347,3 +347,83 @@ fn bad_world_files_are_one_line_errors() {
     let out = run_env(&["--guidance", "sonar"], None);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn flies_a_line_cut_from_a_grid_as_over_the_cut_files() {
+    // `plan fly --grid G --line L` flies the same line as `--profile` and
+    // `--waypoints` over the files `plan profile` cuts from them.
+    let fixtures = root().join("tests/fixtures");
+    let grid = fixtures.join("grids/monterey_gebco.tif");
+    let line = fixtures.join("lines/monterey_1.csv");
+    let dir = std::env::temp_dir().join(format!("auvnav-fly-grid-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (p, w) = (dir.join("p.csv"), dir.join("w.csv"));
+    let cut = Command::new(tool())
+        .args(["profile", "--grid", grid.to_str().unwrap()])
+        .args(["--line", line.to_str().unwrap()])
+        .args(["--out-profile", p.to_str().unwrap()])
+        .args(["--out-waypoints", w.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        cut.status.success(),
+        "{}",
+        String::from_utf8_lossy(&cut.stderr)
+    );
+    let common = ["--guidance", "constant,track", "--json"];
+    let from_grid = json(
+        &[
+            &[
+                "--grid",
+                grid.to_str().unwrap(),
+                "--line",
+                line.to_str().unwrap(),
+            ][..],
+            &common[..],
+        ]
+        .concat(),
+    );
+    let from_files = json(
+        &[
+            &[
+                "--profile",
+                p.to_str().unwrap(),
+                "--waypoints",
+                w.to_str().unwrap(),
+            ][..],
+            &common[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(from_grid["guidance"], from_files["guidance"]);
+    assert!(from_grid["guidance"][0]["flights"].as_u64() == Some(1));
+}
+
+#[test]
+fn conflicting_or_repeated_options_are_errors() {
+    let grid = root().join("tests/fixtures/grids/monterey_gebco.tif");
+    let g = grid.to_str().unwrap();
+    for (args, mention) in [
+        (vec!["--runs", "2", "--runs", "3"], "given twice"),
+        (vec!["--grid", g], "go together"),
+        (vec!["--spacing", "5"], "--spacing needs"),
+        (
+            vec![
+                "--grid",
+                g,
+                "--line",
+                "l.csv",
+                "--profile",
+                "p.csv",
+                "--waypoints",
+                "w.csv",
+            ],
+            "one or the other",
+        ),
+    ] {
+        let out = run_env(&args, None);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(mention), "{args:?}: {err}");
+    }
+}

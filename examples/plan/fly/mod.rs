@@ -27,7 +27,8 @@ use guide::{Kind, Line, Record};
 use world::{Flight, Map, Rng, WorldSpec};
 
 pub const USAGE: &str = "\
-plan fly [--profile P.csv --waypoints W.csv] [--config VEHICLE.toml]
+plan fly [--profile P.csv --waypoints W.csv | --grid GRID --line LINE [--spacing DS]]
+         [--config VEHICLE.toml]
          [--world WORLD.toml] [--guidance G1,G2,...] [--runs N] [--seed S]
          [--horizon K] [--json] [--plot OUT.svg]
 
@@ -37,11 +38,15 @@ guidance (default all): horizon, certified, track, bottom-follow,
 min-altitude, constant. certified uses the config's declared uncertainty;
 horizon the same planner with none declared. --plot draws flight 0 of
 each guidance over its true bottom (below h_a in red, DVL lock lost in
-grey).";
+grey). --grid/--line cut the line from a bathymetry grid as `plan profile`
+does (see plan --help). An option given twice is an error.";
 
 struct Args {
     profile: Option<PathBuf>,
     waypoints: Option<PathBuf>,
+    grid: Option<PathBuf>,
+    line: Option<PathBuf>,
+    spacing: Option<f64>,
     config: Option<PathBuf>,
     world: Option<PathBuf>,
     guidance: Vec<Kind>,
@@ -56,6 +61,9 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
     let mut a = Args {
         profile: None,
         waypoints: None,
+        grid: None,
+        line: None,
+        spacing: None,
         config: None,
         world: None,
         guidance: Kind::ALL.to_vec(),
@@ -65,7 +73,11 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
         json: false,
         plot: None,
     };
+    let mut seen = std::collections::HashSet::new();
     while let Some(flag) = it.next() {
+        if flag.starts_with("--") && !seen.insert(flag.clone()) {
+            return Err(Fail::usage(format!("{flag} is given twice")));
+        }
         let mut value = || {
             it.next()
                 .ok_or_else(|| Fail::usage(format!("{flag} needs a value")))
@@ -74,6 +86,15 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
             "--help" | "-h" => return Err(Fail::Help),
             "--profile" => a.profile = Some(value()?.into()),
             "--waypoints" => a.waypoints = Some(value()?.into()),
+            "--grid" => a.grid = Some(value()?.into()),
+            "--line" => a.line = Some(value()?.into()),
+            "--spacing" => {
+                let v = value()?;
+                let ds = v.parse::<f64>().ok().filter(|d| d.is_finite() && *d > 0.0);
+                a.spacing = Some(ds.ok_or_else(|| {
+                    Fail::usage(format!("--spacing: `{v}` is not a positive distance in m"))
+                })?);
+            }
             "--config" => a.config = Some(value()?.into()),
             "--world" => a.world = Some(value()?.into()),
             "--plot" => a.plot = Some(value()?.into()),
@@ -107,8 +128,24 @@ fn parse(mut it: impl Iterator<Item = String>) -> Result<Args, Fail> {
             }
         }
     }
+    check(a)
+}
+
+/// The options that go together or exclude each other.
+fn check(a: Args) -> Result<Args, Fail> {
     if a.profile.is_some() != a.waypoints.is_some() {
         return Err(Fail::usage("--profile and --waypoints go together".into()));
+    }
+    if a.grid.is_some() != a.line.is_some() {
+        return Err(Fail::usage("--grid and --line go together".into()));
+    }
+    if a.grid.is_some() && a.profile.is_some() {
+        return Err(Fail::usage(
+            "--grid/--line replace --profile/--waypoints: give one or the other".into(),
+        ));
+    }
+    if a.spacing.is_some() && a.grid.is_none() {
+        return Err(Fail::usage("--spacing needs --grid and --line".into()));
     }
     Ok(a)
 }
@@ -209,6 +246,16 @@ struct Inputs {
 /// Reads the profile, waypoints, config and world (input.rs's loaders).
 fn load(a: &Args) -> Result<Inputs, Fail> {
     let (profile_text, profile_name, wp_text, wp_name) = match (&a.profile, &a.waypoints) {
+        _ if a.grid.is_some() => {
+            let (g, l) = a
+                .grid
+                .as_deref()
+                .zip(a.line.as_deref())
+                .ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
+            let (p, w, _) = crate::map::profile_and_waypoints(g, l, a.spacing)?;
+            let name = format!("{} on {}", l.display(), g.display());
+            (p, name, w, l.display().to_string())
+        }
         (Some(p), Some(w)) => (
             input::read(p)?,
             p.display().to_string(),
