@@ -10,7 +10,8 @@
 #      panic-never in release, for both targets, and runs on the M4F;
 #   4. the defmt log example, decoded (cargo qemu-log);
 #   5. the real-time example (examples/qemu_realtime.rs): 0 deadline misses
-#      of the 10 Hz control task over a whole line, under -icount.
+#      of the 10 Hz control task over a whole line, under -icount;
+#   6. the same under RTIC 2 (crates/auvnav-rtic, its own workspace).
 # The benchmarks are scripts/qemu-bench.sh (CI runs them too).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,5 +37,8 @@ cargo qemu-log
 
 say "target: real-time integration (timer-driven control at 10 Hz, resumable planner in the main loop, -icount)"
 QEMU_ICOUNT=shift=3,sleep=off cargo run --release --target thumbv7em-none-eabihf --example qemu_realtime
+
+say "target: real-time integration under RTIC 2 (crates/auvnav-rtic: TIMER0 task at 10 Hz, planner as a software task)"
+(cd crates/auvnav-rtic && QEMU_ICOUNT=shift=3,sleep=off cargo run --release)
 
 say "all on-target tests passed"
