@@ -277,7 +277,9 @@ pub mod timer {
     /// The timer's input clock, Hz (the mps2 boards' `SYSCLK_FRQ`).
     pub const CLOCK_HZ: u32 = 25_000_000;
 
-    static HANDLER: Mutex<Cell<Option<fn()>>> = Mutex::new(Cell::new(None));
+    /// The handler the timer's interrupt calls, once one is installed.
+    type Slot = Mutex<Cell<Option<fn()>>>;
+    static HANDLER: Slot = Mutex::new(Cell::new(None));
 
     #[derive(Clone, Copy)]
     struct Irq;
