@@ -31,3 +31,11 @@ pub mod fail;
 #[path = "../../examples/plan/input.rs"]
 #[allow(dead_code)]
 pub mod input;
+// What args.rs and input.rs reach of the map side (`--spacing`, lat/lon
+// waypoint columns) and what that reaches of the report.
+#[path = "../../examples/plan/map/mod.rs"]
+#[allow(dead_code)]
+pub mod map;
+#[path = "../../examples/plan/report.rs"]
+#[allow(dead_code)]
+pub mod report;
