@@ -15,6 +15,7 @@ mod map;
 mod plot;
 mod progress;
 mod report;
+mod source;
 
 use std::process::ExitCode;
 
@@ -31,6 +32,7 @@ use input::{MAX_HORIZON, SAMPLES, WAYPOINTS};
 /// crossings per sample.
 const ENVELOPE: usize = 3 * SAMPLES + 1;
 use report::{Report, TrackReport, TrajRow};
+use source::{LineInput, LineSource};
 
 fn main() -> ExitCode {
     // Subcommands by their first argument; anything else is the planner.
@@ -59,11 +61,14 @@ fn main() -> ExitCode {
 fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     let args = args?;
     // What the report calls the profile and the vehicle.
-    let profile_label = match (&args.profile, &args.grid, &args.line) {
-        (Some(p), _, _) => p.display().to_string(),
-        (_, Some(g), Some(l)) => format!("{} on {}", l.display(), g.display()),
-        _ => "us_monterey_canyon_1 (bundled)".to_string(),
+    let source = LineSource {
+        profile: args.profile.as_deref(),
+        waypoints: args.waypoints.as_deref(),
+        grid: args.grid.as_deref(),
+        line: args.line.as_deref(),
+        spacing: args.spacing,
     };
+    let profile_label = source.label();
     let vehicle_label = args.config.as_ref().map_or_else(
         || "C-AUV #4 (default)".to_string(),
         |p| p.display().to_string(),
@@ -74,7 +79,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         wp_text,
         wp_name,
         mut cut,
-    } = line_input(&args, &profile_label)?;
+    } = source.read()?;
     let config_text = match &args.config {
         Some(p) => Some((input::read(p)?, p.display().to_string())),
         None => None,
@@ -267,52 +272,6 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         print!("{}", report.table());
     }
     Ok(())
-}
-
-/// The profile and waypoint texts a run plans over, with their names:
-/// cut from `--grid/--line` (and the cut, for the chart), read from
-/// `--profile/--waypoints`, or the bundled line. `label`: the report's
-/// name of the profile.
-struct LineInput {
-    profile_text: String,
-    profile_name: String,
-    wp_text: String,
-    wp_name: String,
-    cut: Option<map::Cut>,
-}
-
-fn line_input(args: &Args, label: &str) -> Result<LineInput, Fail> {
-    let mut cut = None;
-    let (profile_text, profile_name, wp_text, wp_name) = match (&args.profile, &args.waypoints) {
-        _ if args.grid.is_some() => {
-            let (g, l) = (args.grid.as_deref(), args.line.as_deref());
-            let (g, l) = g
-                .zip(l)
-                .ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
-            let (p, w, c) = map::profile_and_waypoints(g, l, args.spacing)?;
-            cut = Some(c);
-            (p, label.to_string(), w, l.display().to_string())
-        }
-        (Some(p), Some(w)) => (
-            input::read(p)?,
-            p.display().to_string(),
-            input::read(w)?,
-            w.display().to_string(),
-        ),
-        _ => (
-            input::BUNDLED_PROFILE.to_string(),
-            "us_monterey_canyon_1.csv (bundled)".to_string(),
-            input::BUNDLED_WAYPOINTS.to_string(),
-            "us_monterey_canyon_1.waypoints.csv (bundled)".to_string(),
-        ),
-    };
-    Ok(LineInput {
-        profile_text,
-        profile_name,
-        wp_text,
-        wp_name,
-        cut,
-    })
 }
 
 /// A profile's name for a title: the file stems, not the whole paths

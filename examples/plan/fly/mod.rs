@@ -245,30 +245,20 @@ struct Inputs {
 
 /// Reads the profile, waypoints, config and world (input.rs's loaders).
 fn load(a: &Args) -> Result<Inputs, Fail> {
-    let (profile_text, profile_name, wp_text, wp_name) = match (&a.profile, &a.waypoints) {
-        _ if a.grid.is_some() => {
-            let (g, l) = a
-                .grid
-                .as_deref()
-                .zip(a.line.as_deref())
-                .ok_or_else(|| Fail::usage("--grid needs --line".into()))?;
-            let (p, w, _) = crate::map::profile_and_waypoints(g, l, a.spacing)?;
-            let name = format!("{} on {}", l.display(), g.display());
-            (p, name, w, l.display().to_string())
-        }
-        (Some(p), Some(w)) => (
-            input::read(p)?,
-            p.display().to_string(),
-            input::read(w)?,
-            w.display().to_string(),
-        ),
-        _ => (
-            input::BUNDLED_PROFILE.to_string(),
-            "us_monterey_canyon_1.csv (bundled)".to_string(),
-            input::BUNDLED_WAYPOINTS.to_string(),
-            "us_monterey_canyon_1.waypoints.csv (bundled)".to_string(),
-        ),
-    };
+    let crate::source::LineInput {
+        profile_text,
+        profile_name,
+        wp_text,
+        wp_name,
+        ..
+    } = crate::source::LineSource {
+        profile: a.profile.as_deref(),
+        waypoints: a.waypoints.as_deref(),
+        grid: a.grid.as_deref(),
+        line: a.line.as_deref(),
+        spacing: a.spacing,
+    }
+    .read()?;
     let config_text = match &a.config {
         Some(p) => Some((input::read(p)?, p.display().to_string())),
         None => None,
