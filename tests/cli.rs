@@ -15,26 +15,12 @@
 )]
 #![allow(clippy::arithmetic_side_effects, clippy::float_cmp)]
 
+mod tool;
+
+use tool::{run, tool};
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn tool() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    let p = dir
-        .join("examples")
-        .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        p.exists(),
-        "{} not built: run `cargo build --examples` first (scripts/test-all.sh does)",
-        p.display()
-    );
-    p
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(tool()).args(args).output().unwrap()
-}
+use std::process::Command;
 
 fn tmp(name: &str, text: &str) -> PathBuf {
     static COUNT: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);

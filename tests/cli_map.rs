@@ -20,28 +20,14 @@
 )]
 #![allow(clippy::arithmetic_side_effects, clippy::float_cmp)]
 
+mod tool;
+
+use tool::run;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
-
-fn tool() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    let p = dir
-        .join("examples")
-        .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        p.exists(),
-        "{} not built: cargo build --examples",
-        p.display()
-    );
-    p
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(tool()).args(args).output().unwrap()
-}
 
 fn fixture(rel: &str) -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -14,24 +14,14 @@
 )]
 #![allow(clippy::arithmetic_side_effects, clippy::float_cmp)]
 
+mod tool;
+
+use tool::tool;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use serde_json::Value;
-
-fn tool() -> PathBuf {
-    let exe = std::env::current_exe().unwrap();
-    let dir = exe.parent().unwrap().parent().unwrap();
-    let p = dir
-        .join("examples")
-        .join(format!("plan{}", std::env::consts::EXE_SUFFIX));
-    assert!(
-        p.exists(),
-        "{} not built: run `cargo build --examples`",
-        p.display()
-    );
-    p
-}
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
