@@ -36,17 +36,23 @@
 fn main() {}
 
 #[cfg(target_os = "none")]
+#[path = "realtime/flight.rs"]
+mod flight;
+
+#[cfg(target_os = "none")]
 mod firmware {
     use core::cell::RefCell;
 
     use auvnav::{
-        AutopilotState, Measurement, Mission, Planner, PlannerConfig, ProfileView, Resumable,
-        Scenario, Step, TrackScore, Vehicle, VehicleState, Waypoints,
+        Mission, Planner, PlannerConfig, ProfileView, Resumable, Scenario, Step, TrackScore,
+        Vehicle, VehicleState, Waypoints,
     };
     use auvnav_qemu::timer;
     use cortex_m::interrupt::{self, Mutex};
     use cortex_m_rt::entry;
     use cortex_m_semihosting::hprintln;
+
+    use crate::flight::{Arrival, Flight, IPS, MAP_B, MAP_X, STEP_FLIGHTS, Times, WAYPOINTS};
 
     #[panic_handler]
     fn panic(info: &core::panic::PanicInfo) -> ! {
@@ -54,39 +60,19 @@ mod firmware {
         auvnav_qemu::exit(false)
     }
 
-    /// The mapped bottom under the line, m (as `examples/firmware_loop.rs`).
-    static MAP_X: [f32; 7] = [0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0];
-    static MAP_B: [f32; 7] = [500.0, 480.0, 430.0, 330.0, 300.0, 310.0, 320.0];
-    /// The line's waypoints, m along track.
-    static WAYPOINTS: [f32; 4] = [0.0, 800.0, 1600.0, 2380.0];
-    /// Flights per planner step.
-    const STEP_FLIGHTS: u32 = 8;
-    /// Virtual instructions per simulated second (`-icount shift=3`).
-    const IPS: f32 = 125.0e6;
     /// Timer ticks per control period (10 Hz).
     const PERIOD: u32 = timer::CLOCK_HZ / 10;
 
     /// What the control task and the planner share.
     struct Control {
-        vehicle: Vehicle<3>,
-        /// The vehicle: plant state, depth, position (and previous).
-        eta: [f32; 3],
-        d: [f32; 2],
-        x: [f32; 2],
-        ap: AutopilotState,
-        /// The track flown and its reference depth, m.
-        track: usize,
-        reference: f32,
-        /// The depth prepared for the next track, m.
-        next: Option<f32>,
-        /// A waypoint reached: the new track and what was measured there.
-        arrived: Option<(usize, Measurement, [f32; 2])>,
+        /// The vehicle flying the line.
+        flight: Flight,
+        /// A waypoint reached, for the planner.
+        arrived: Option<Arrival>,
         /// Control periods run, worst release latency (ticks), misses.
         ticks: u32,
         worst_latency: u32,
         misses: u32,
-        min_altitude: f32,
-        done: bool,
     }
 
     static CONTROL: Mutex<RefCell<Option<Control>>> = Mutex::new(RefCell::new(None));
@@ -99,8 +85,10 @@ mod firmware {
             if let Some(c) = CONTROL.borrow(cs).borrow_mut().as_mut() {
                 c.worst_latency = c.worst_latency.max(latency);
                 c.ticks += 1;
-                if !c.done {
-                    fly_one_sample(c);
+                if !c.flight.done
+                    && let Some(a) = c.flight.sample()
+                {
+                    c.arrived = Some(a);
                 }
             }
         });
@@ -114,45 +102,6 @@ mod firmware {
         }
     }
 
-    /// One sample: the autopilot on the measurements, then the vehicle.
-    fn fly_one_sample(c: &mut Control) {
-        let vehicle = c.vehicle;
-        let plant = vehicle.plant();
-        let (u, ts) = (vehicle.speed(), vehicle.sample_time());
-        let theta = plant.pitch(&c.eta);
-        let cmd = vehicle.autopilot().update(
-            &mut c.ap,
-            c.reference,
-            c.d[0],
-            theta,
-            plant.pitch_rate(&c.eta),
-        );
-        c.eta = plant.step(&c.eta, cmd.elevator);
-        let mean = 0.5 * (theta + plant.pitch(&c.eta)).to_radians();
-        c.d = [c.d[0] - u * ts * libm::sinf(mean), c.d[0]];
-        c.x = [c.x[0] + u * ts * libm::cosf(mean), c.x[0]];
-        if let Ok(map) = ProfileView::new(&MAP_X, &MAP_B)
-            && let Ok(b) = map.depth_at(c.x[0].min(WAYPOINTS[3]))
-        {
-            c.min_altitude = c.min_altitude.min(b - c.d[0]);
-        }
-        if c.x[0] >= WAYPOINTS[3] {
-            c.done = true;
-        } else if c.x[0] >= WAYPOINTS[c.track + 1] {
-            c.track += 1;
-            if let Some(z) = c.next.take() {
-                c.reference = z;
-            }
-            let m = Measurement {
-                x: c.x[0],
-                depth: c.d[0],
-                pitch: plant.pitch(&c.eta),
-                pitch_rate: plant.pitch_rate(&c.eta),
-            };
-            c.arrived = Some((c.track, m, [c.ap.depth_integral, c.ap.pitch_integral]));
-        }
-    }
-
     /// Simulated time now, s (control periods and the timer's count).
     fn now() -> f32 {
         let (ticks, value) = interrupt::free(|cs| {
@@ -160,17 +109,6 @@ mod firmware {
             (t, timer::value())
         });
         (ticks as f32 + (PERIOD - 1 - value.min(PERIOD - 1)) as f32 / PERIOD as f32) * 0.1
-    }
-
-    /// Per-call and per-step planner times, s.
-    #[derive(Default)]
-    struct Times {
-        calls: u32,
-        steps: u32,
-        worst_call: f32,
-        worst_step: f32,
-        total: f32,
-        all_safe: bool,
     }
 
     /// Plans `track` from `st` in resumable steps; its depth.
@@ -253,57 +191,31 @@ mod firmware {
             all_safe: t.all_safe,
             ..Times::default()
         };
+        let (flight, arrival) = Flight::new(vehicle, d0, z0);
         interrupt::free(|cs| {
             *CONTROL.borrow(cs).borrow_mut() = Some(Control {
-                vehicle,
-                eta: [0.0; 3],
-                d: [d0, d0],
-                x: [0.0, 0.0],
-                ap: AutopilotState::trimmed(d0),
-                track: 0,
-                reference: z0,
-                next: None,
-                arrived: Some((
-                    0,
-                    Measurement {
-                        x: 0.0,
-                        depth: d0,
-                        pitch: 0.0,
-                        pitch_rate: 0.0,
-                    },
-                    [0.0, 0.0],
-                )),
+                flight,
+                arrived: Some(arrival),
                 ticks: 0,
                 worst_latency: 0,
                 misses: 0,
-                min_altitude: f32::INFINITY,
-                done: false,
             });
         });
         timer::start(PERIOD - 1, 0, control);
-        let (mut prior, mut z) = (start, z0);
+        let mut prior = start;
         loop {
             let (arrived, done) = interrupt::free(|cs| {
                 let mut c = CONTROL.borrow(cs).borrow_mut();
                 c.as_mut()
-                    .map_or((None, true), |c| (c.arrived.take(), c.done))
+                    .map_or((None, true), |c| (c.arrived.take(), c.flight.done))
             });
             if done {
                 break;
             }
-            let Some((n, m, ints)) = arrived else {
+            let Some(Arrival(n, m, ints, z)) = arrived else {
                 cortex_m::asm::wfi();
                 continue;
             };
-            if n > 0 {
-                z = interrupt::free(|cs| {
-                    CONTROL
-                        .borrow(cs)
-                        .borrow()
-                        .as_ref()
-                        .map_or(z, |c| c.reference)
-                });
-            }
             // The measured state, the predicted one at the next waypoint,
             // and the plan of the track after this one.
             let st = VehicleState::measured(&prior, &m)?.with_integrals(ints[0], ints[1])?;
@@ -314,7 +226,7 @@ mod firmware {
             if let Some(next) = plan_track(&mut r, &sc, &prior, n + 1, &mut t) {
                 interrupt::free(|cs| {
                     if let Some(c) = CONTROL.borrow(cs).borrow_mut().as_mut() {
-                        c.next = Some(next);
+                        c.flight.next = Some(next);
                     }
                 });
             }
@@ -323,7 +235,7 @@ mod firmware {
         let c = interrupt::free(|cs| {
             let c = CONTROL.borrow(cs).borrow();
             c.as_ref()
-                .map(|c| (c.ticks, c.worst_latency, c.misses, c.min_altitude))
+                .map(|c| (c.ticks, c.worst_latency, c.misses, c.flight.min_altitude))
         });
         let Some((ticks, latency, misses, min_alt)) = c else {
             return Ok(false);

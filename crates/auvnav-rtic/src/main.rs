@@ -11,6 +11,10 @@
 #![no_main]
 #![allow(clippy::arithmetic_side_effects, clippy::indexing_slicing)]
 
+// The line, the simulated vehicle and the timing record, shared with the
+// super-loop example.
+#[path = "../../../examples/realtime/flight.rs"]
+mod flight;
 mod pac;
 
 use auvnav_qemu::timer;
@@ -40,48 +44,28 @@ fn timer_stop() {
 #[rtic::app(device = crate::pac, peripherals = false, dispatchers = [TIMER1])]
 mod app {
     use super::*;
+    use crate::flight::{Arrival, Flight, IPS, MAP_B, MAP_X, STEP_FLIGHTS, Times, WAYPOINTS};
     use auvnav::{
-        AutopilotState, Measurement, Mission, Planner, PlannerConfig, ProfileView, Resumable,
-        Scenario, Step, TrackScore, Vehicle, VehicleState, Waypoints,
+        Mission, Planner, PlannerConfig, ProfileView, Resumable, Scenario, Step, TrackScore,
+        Vehicle, VehicleState, Waypoints,
     };
     use rtic::Mutex;
 
-    static MAP_X: [f32; 7] = [0.0, 400.0, 800.0, 1200.0, 1600.0, 2000.0, 2400.0];
-    static MAP_B: [f32; 7] = [500.0, 480.0, 430.0, 330.0, 300.0, 310.0, 320.0];
-    static WAYPOINTS: [f32; 4] = [0.0, 800.0, 1600.0, 2380.0];
-    const STEP_FLIGHTS: u32 = 8;
-    const IPS: f32 = 125.0e6;
+    /// Timer ticks per control period (10 Hz).
     const PERIOD: u32 = timer::CLOCK_HZ / 10;
 
-    /// A waypoint reached: track, measurement, integrals, its reference.
-    pub struct Arrival(usize, Measurement, [f32; 2], f32);
-
+    /// What the control task keeps.
     pub struct Control {
-        vehicle: Vehicle<3>,
-        eta: [f32; 3],
-        d: [f32; 2],
-        x: [f32; 2],
-        ap: AutopilotState,
-        track: usize,
-        reference: f32,
-        next: Option<f32>,
+        /// The vehicle flying the line.
+        flight: Flight,
+        /// A waypoint reached, for the planner.
         arrived: Option<Arrival>,
+        /// Control periods run, worst release latency (ticks), misses,
+        /// planner calls that could not start (the last still running).
         ticks: u32,
         worst_latency: u32,
         misses: u32,
         overruns: u32,
-        min_altitude: f32,
-        done: bool,
-    }
-
-    #[derive(Default)]
-    pub struct Times {
-        calls: u32,
-        steps: u32,
-        worst_call: f32,
-        worst_step: f32,
-        total: f32,
-        all_safe: bool,
     }
 
     #[shared]
@@ -126,28 +110,14 @@ mod app {
             _ => (d0, false),
         };
         hprintln!("track 1: depth {} m (planned before launch)", z0);
-        let m0 = Measurement {
-            x: 0.0,
-            depth: d0,
-            pitch: 0.0,
-            pitch_rate: 0.0,
-        };
+        let (flight, arrival) = Flight::new(*v, d0, z0);
         let control = Control {
-            vehicle: *v,
-            eta: [0.0; 3],
-            d: [d0, d0],
-            x: [0.0, 0.0],
-            ap: AutopilotState::trimmed(d0),
-            track: 0,
-            reference: z0,
-            next: None,
-            arrived: Some(Arrival(0, m0, [0.0, 0.0], z0)),
+            flight,
+            arrived: Some(arrival),
             ticks: 0,
             worst_latency: 0,
             misses: 0,
             overruns: 0,
-            min_altitude: f32::INFINITY,
-            done: false,
         };
         timer_start(PERIOD - 1);
         let times = Times {
@@ -172,8 +142,10 @@ mod app {
         let arrived = cx.shared.control.lock(|c| {
             c.worst_latency = c.worst_latency.max(latency);
             c.ticks += 1;
-            if !c.done {
-                fly_one_sample(c);
+            if !c.flight.done
+                && let Some(a) = c.flight.sample()
+            {
+                c.arrived = Some(a);
             }
             c.arrived.take()
         });
@@ -184,45 +156,6 @@ mod app {
                 c.misses += u32::from(missed);
                 c.overruns += u32::from(overrun);
             });
-        }
-    }
-
-    fn fly_one_sample(c: &mut Control) {
-        let vehicle = c.vehicle;
-        let plant = vehicle.plant();
-        let (u, ts) = (vehicle.speed(), vehicle.sample_time());
-        let theta = plant.pitch(&c.eta);
-        let cmd = vehicle.autopilot().update(
-            &mut c.ap,
-            c.reference,
-            c.d[0],
-            theta,
-            plant.pitch_rate(&c.eta),
-        );
-        c.eta = plant.step(&c.eta, cmd.elevator);
-        let mean = 0.5 * (theta + plant.pitch(&c.eta)).to_radians();
-        c.d = [c.d[0] - u * ts * libm::sinf(mean), c.d[0]];
-        c.x = [c.x[0] + u * ts * libm::cosf(mean), c.x[0]];
-        if let Ok(map) = ProfileView::new(&MAP_X, &MAP_B)
-            && let Ok(b) = map.depth_at(c.x[0].min(WAYPOINTS[3]))
-        {
-            c.min_altitude = c.min_altitude.min(b - c.d[0]);
-        }
-        if c.x[0] >= WAYPOINTS[3] {
-            c.done = true;
-        } else if c.x[0] >= WAYPOINTS[c.track + 1] {
-            c.track += 1;
-            if let Some(z) = c.next.take() {
-                c.reference = z;
-            }
-            let m = Measurement {
-                x: c.x[0],
-                depth: c.d[0],
-                pitch: plant.pitch(&c.eta),
-                pitch_rate: plant.pitch_rate(&c.eta),
-            };
-            let ints = [c.ap.depth_integral, c.ap.pitch_integral];
-            c.arrived = Some(Arrival(c.track, m, ints, c.reference));
         }
     }
 
@@ -279,13 +212,13 @@ mod app {
                 p.certified_min_altitude,
                 dt
             );
-            cx.shared.control.lock(|c| c.next = Some(p.depth));
+            cx.shared.control.lock(|c| c.flight.next = Some(p.depth));
         }
     }
 
     #[idle(shared = [control, times])]
     fn idle(mut cx: idle::Context) -> ! {
-        while !cx.shared.control.lock(|c| c.done) {
+        while !cx.shared.control.lock(|c| c.flight.done) {
             cortex_m::asm::wfi();
         }
         timer_stop();
@@ -295,7 +228,7 @@ mod app {
                 c.worst_latency,
                 c.misses,
                 c.overruns,
-                c.min_altitude,
+                c.flight.min_altitude,
             )
         });
         let (calls, worst, total, steps, worst_step, safe) = cx.shared.times.lock(|t| {
