@@ -31,6 +31,20 @@ const LINES: [(&str, f32, f32); 6] = [
     ("jp_aburatsubo_sagami_1", 2.0, 1.0),
 ];
 
+/// A shared line's profile and waypoints.
+fn line(name: &str) -> (Profile<4096>, Waypoints<16>) {
+    let (x, b) = real_profile(name);
+    let map = Profile::new(&x, &b).unwrap();
+    (map, Waypoints::new(&real_waypoints(name)).unwrap())
+}
+
+/// Every track the unbudgeted run (`free`) flies safe is safe in `safe`.
+fn assert_as_safe(free: &[bool], safe: &[bool], what: &str) {
+    for (t, (&f, &ok)) in free.iter().zip(safe).enumerate() {
+        assert!(!f || ok, "{what} track {}: not safe", t + 1);
+    }
+}
+
 /// One line planned call after call from the predicted states: depths,
 /// safety, `J` and the flights of each call.
 struct Flown {
@@ -101,9 +115,7 @@ fn open_loop(sc: &Scenario<'_, 3>, depths: &[f32]) -> Vec<f32> {
 fn every_call_stays_within_its_budget_and_the_line_stays_safe() {
     let vehicle = Vehicle::c_auv4().unwrap();
     for (name, h_r, h_a) in LINES {
-        let (x, b) = real_profile(name);
-        let map = Profile::<4096>::new(&x, &b).unwrap();
-        let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+        let (map, wps) = line(name);
         let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
         let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
         let free = fly_line(&sc, u32::MAX, false);
@@ -115,10 +127,8 @@ fn every_call_stays_within_its_budget_and_the_line_stays_safe() {
                 if ok {
                     assert!(h >= h_a, "{name} budget {budget} track {}: {h}", t + 1);
                 }
-                if free.safe.get(t) == Some(&true) {
-                    assert!(ok, "{name} budget {budget} track {}: not safe", t + 1);
-                }
             }
+            assert_as_safe(&free.safe, &run.safe, &format!("{name} budget {budget}"));
             js.push(format!("{:.2}", run.j / free.j));
         }
         // A row of BENCHMARKS.md's table: J by budget, against unbudgeted.
@@ -135,19 +145,13 @@ fn every_call_stays_within_its_budget_and_the_line_stays_safe() {
 fn from_measured_states_too() {
     let vehicle = Vehicle::c_auv4().unwrap();
     for (name, h_r, h_a) in [LINES[0], LINES[3]] {
-        let (x, b) = real_profile(name);
-        let map = Profile::<4096>::new(&x, &b).unwrap();
-        let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+        let (map, wps) = line(name);
         let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
         let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
         let free = fly_line(&sc, u32::MAX, true);
         for budget in [1, 2, 5, 20] {
             let run = fly_line(&sc, budget, true);
-            for (t, &ok) in run.safe.iter().enumerate() {
-                if free.safe.get(t) == Some(&true) {
-                    assert!(ok, "{name} budget {budget} track {}: not safe", t + 1);
-                }
-            }
+            assert_as_safe(&free.safe, &run.safe, &format!("{name} budget {budget}"));
         }
     }
 }
@@ -156,9 +160,7 @@ fn from_measured_states_too() {
 fn under_declared_uncertainty_each_world_is_a_flight() {
     let vehicle = Vehicle::c_auv4().unwrap();
     let name = "us_monterey_canyon_1";
-    let (x, b) = real_profile(name);
-    let map = Profile::<4096>::new(&x, &b).unwrap();
-    let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+    let (map, wps) = line(name);
     // Map error and a speed error: 3 worlds over the lower envelope.
     let u = Uncertainty::new(5.0, 0.001, 2.0, 0.05, 0.0, 0.0).unwrap();
     let env = lower_envelope::<12288>(map.view(), &u, wps.positions()[0]).unwrap();
@@ -183,11 +185,7 @@ fn under_declared_uncertainty_each_world_is_a_flight() {
     let free = fly_line(&sc, u32::MAX, false);
     for budget in [7, 10, 20, 50] {
         let run = fly_line(&sc, budget, false);
-        for (t, &ok) in run.safe.iter().enumerate() {
-            if free.safe.get(t) == Some(&true) {
-                assert!(ok, "budget {budget} track {}: not safe", t + 1);
-            }
-        }
+        assert_as_safe(&free.safe, &run.safe, &format!("budget {budget}"));
     }
 }
 
@@ -197,9 +195,7 @@ fn under_declared_uncertainty_each_world_is_a_flight() {
 fn the_resumable_planner_steps_within_its_flights() {
     let vehicle = Vehicle::c_auv4().unwrap();
     for (name, h_r, h_a) in LINES {
-        let (x, b) = real_profile(name);
-        let map = Profile::<4096>::new(&x, &b).unwrap();
-        let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
+        let (map, wps) = line(name);
         let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
         let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
         let free = fly_line(&sc, u32::MAX, false);
@@ -231,10 +227,8 @@ fn the_resumable_planner_steps_within_its_flights() {
                 if ok {
                     assert!(h >= h_a, "{name} per step {per_step} track {}: {h}", t + 1);
                 }
-                if free.safe.get(t) == Some(&true) {
-                    assert!(ok, "{name} per step {per_step} track {}: not safe", t + 1);
-                }
             }
+            assert_as_safe(&free.safe, &safe, &format!("{name} per step {per_step}"));
             println!(
                 "{name}: resumable, {per_step} flights a step: J {:.2} of the blocking call's, {steps} steps",
                 j / free.j
