@@ -126,5 +126,6 @@ impl Certificate {
     pub(super) const NONE: Self = Self {
         first: f32::NEG_INFINITY,
         all: f32::NEG_INFINITY,
+        partial: false,
     };
 }

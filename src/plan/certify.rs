@@ -23,11 +23,16 @@
 //! declared). It is conservative by design, and costs `J` only when
 //! vehicle uncertainty is declared.
 
+use core::cell::Cell;
+
 use heapless::Vec;
 
 use crate::model::{ProfileView, Uncertainty, Vehicle};
 use crate::num::DEG;
 use crate::sim::{MAX_WORLDS, Scenario, SimError, TrackScore, VehicleState, World};
+
+// The critical worlds are the bits of a `u128`.
+const _: () = assert!(MAX_WORLDS <= 128);
 
 /// The time over which the vehicle margin accumulates, s (module docs).
 const MARGIN_TIME: f32 = 15.0;
@@ -49,6 +54,12 @@ pub(super) struct Tube<const N: usize> {
     /// The vehicle margin subtracted from every certified altitude, m.
     margin: f32,
     states: [VehicleState<N>; MAX_WORLDS],
+    /// The world whose flight set the last certificate's least altitude:
+    /// flown first, so that an uncertifiable line is found in one flight.
+    worst: Cell<usize>,
+    /// The worlds that have set a certificate's least altitude since the
+    /// tube was last restarted (bit `i`: world `i`).
+    critical: Cell<u128>,
     /// The track those states start, and the nominal state they go with.
     track: usize,
     nominal: Option<VehicleState<N>>,
@@ -60,6 +71,8 @@ impl<const N: usize> Default for Tube<N> {
             worlds: Vec::new(),
             margin: 0.0,
             states: [VehicleState::trimmed(0.0, 0.0); MAX_WORLDS],
+            worst: Cell::new(0),
+            critical: Cell::new(0),
             track: 0,
             nominal: None,
         }
@@ -75,6 +88,10 @@ pub(super) struct Certificate {
     /// Least altitude over the worlds to the end of the line, m
     /// (`-inf` when a flight failed).
     pub all: f32,
+    /// Whether some worlds were left unflown because one already fell
+    /// below the floor asked for: `first` and `all` are then upper bounds
+    /// (the line is not certified either way).
+    pub partial: bool,
 }
 
 impl<const N: usize> Tube<N> {
@@ -94,6 +111,7 @@ impl<const N: usize> Tube<N> {
         if !kept {
             self.worlds = worlds;
             self.states = [*state; MAX_WORLDS];
+            self.critical.set(0);
             self.track = track;
             self.nominal = Some(*state);
         }
@@ -153,6 +171,7 @@ impl<const N: usize> Tube<N> {
         Certificate {
             first: min_altitude,
             all: min_altitude,
+            partial: false,
         }
     }
 
@@ -162,19 +181,85 @@ impl<const N: usize> Tube<N> {
     }
 
     /// Flies `depths` (the tube's track first, one depth per track) in
-    /// every world over `bottom` from its state; counts the flights.
+    /// every world over `bottom` from its state; counts the flights. The
+    /// world that was worst last time flies first; once a world's least
+    /// altitude (less the margin) is below `floor` (m) the rest are left
+    /// unflown and the certificate is `partial` (`f32::NEG_INFINITY`: fly
+    /// them all).
     pub fn certify(
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
         depths: &[f32],
+        (floor, flights): (f32, &mut u32),
+    ) -> Certificate {
+        let mut c = Certificate {
+            first: f32::INFINITY,
+            all: f32::INFINITY,
+            partial: false,
+        };
+        let n = self.worlds.len();
+        let start = self.worst.get().min(n.saturating_sub(1));
+        let order = (start..n).chain(0..start);
+        for (k, i) in order.enumerate() {
+            let (Some(w), Some(st)) = (self.worlds.get(i), self.states.get(i)) else {
+                continue;
+            };
+            let at = (st, self.track);
+            let (first, all) = fly_world(sc, w, bottom, at, depths, (0.0, &mut []), flights);
+            c.first = c.first.min(first - self.margin);
+            if all - self.margin < c.all {
+                c.all = all - self.margin;
+                self.worst.set(i);
+            }
+            if c.all < floor && k.saturating_add(1) < n {
+                c.partial = true;
+                break;
+            }
+        }
+        self.mark_worst();
+        c
+    }
+
+    /// Adds the worst world to the critical ones.
+    fn mark_worst(&self) {
+        let bit = 1u128.checked_shl(u32::try_from(self.worst.get()).unwrap_or(u32::MAX));
+        self.critical.set(self.critical.get() | bit.unwrap_or(0));
+    }
+
+    /// The critical worlds (bit `i`: world `i`), never none: the worst
+    /// world at least.
+    pub fn critical(&self) -> u128 {
+        self.mark_worst();
+        self.critical.get()
+    }
+
+    /// Flies `depths` as [`Tube::certify`] does, in the worlds of `mask`
+    /// only (bit `i`: world `i`): the certificate is `partial` unless the
+    /// mask holds every world; its altitudes bound the full one's from
+    /// above.
+    pub fn certify_only(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        depths: &[f32],
+        mask: u128,
         flights: &mut u32,
     ) -> Certificate {
         let mut c = Certificate {
             first: f32::INFINITY,
             all: f32::INFINITY,
+            partial: false,
         };
-        for (w, st) in self.worlds.iter().zip(self.states.iter()) {
+        for (i, (w, st)) in self.worlds.iter().zip(self.states.iter()).enumerate() {
+            let on = u32::try_from(i)
+                .ok()
+                .and_then(|i| mask.checked_shr(i))
+                .is_some_and(|m| m & 1 == 1);
+            if !on {
+                c.partial = true;
+                continue;
+            }
             let at = (st, self.track);
             let (first, all) = fly_world(sc, w, bottom, at, depths, (0.0, &mut []), flights);
             c.first = c.first.min(first - self.margin);

@@ -40,12 +40,20 @@ const SEARCH_SHARE: f32 = 0.002;
 /// The search stops when the step along the path is this short (of 1).
 const SEARCH_WIDTH: f32 = 1e-3;
 
+/// Most rounds of the continuation search (a round: a root search in the
+/// critical worlds, then the point found certified in every world).
+const SEARCH_ROUNDS: u32 = 4;
+
 /// The search path's ends: the certified anchor and the candidate, each
 /// with its certificate.
 type Ends<'c, const N: usize> = (
     (&'c [f32; MAX_TRACKS], Certificate),
     (&'c [f32; MAX_TRACKS], Certificate),
 );
+
+/// A search bracket: the safe end and the unsafe one, each a point on the
+/// path (of 1) with its certified margin over `h_safe`, m.
+type Bracket = ((f32, f32), (f32, f32));
 
 /// A continuation with its certificate.
 #[derive(Clone, Copy, Debug)]
@@ -77,7 +85,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut flights = cand.evaluations;
         let guaranteed = self.cfg.mode == Mode::Horizon && self.cfg.constrained;
         let chosen = if guaranteed {
-            self.continue_safely(sc, bottom, (state, track), &cand, &mut flights)?
+            let c = self.continue_safely(sc, bottom, (state, track), &cand, &mut flights)?;
+            self.completed(sc, bottom, c, &mut flights)
         } else {
             let mut depths = [0.0; MAX_TRACKS];
             depths[0] = cand.flown.depth;
@@ -157,7 +166,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             cert_c
         } else {
             let spare = self.budget.anchor;
-            self.certify_within(sc, bottom, c2.get(..len).unwrap_or(&[]), flights, spare)
+            let at = (cand.h_safe, &mut *flights);
+            self.certify_within(sc, bottom, c2.get(..len).unwrap_or(&[]), at, spare)
         };
         if cert_c2.all >= cand.h_safe {
             return Ok(Chosen {
@@ -179,7 +189,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         for (a, is_prev) in anchors.chain([([shallow; MAX_TRACKS], false)]) {
             let cert_a = match self.budget.known_anchor(is_prev, (&a, &c, cert_c), len) {
                 Some(known) => known,
-                None => self.certify_within(sc, bottom, a.get(..len).unwrap_or(&[]), flights, 0),
+                None => {
+                    let at = (cand.h_safe, &mut *flights);
+                    self.certify_within(sc, bottom, a.get(..len).unwrap_or(&[]), at, 0)
+                }
             };
             if cert_a.all >= cand.h_safe {
                 let ends = ((&a, cert_a), (&c, cert_c));
@@ -197,6 +210,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         Ok(best)
     }
 
+    /// `chosen` with its certificate complete: a partial one (some worlds
+    /// left unflown, its altitudes upper bounds) is flown again in every
+    /// world, budget permitting (else it is no certificate at all).
+    fn completed(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        mut chosen: Chosen<N>,
+        flights: &mut u32,
+    ) -> Chosen<N> {
+        if chosen.cert.partial {
+            let d = chosen.depths.get(..chosen.len).unwrap_or(&[]);
+            let at = (f32::NEG_INFINITY, &mut *flights);
+            chosen.cert = self.certify_within(sc, bottom, d, at, 0);
+        }
+        chosen
+    }
+
     /// The candidate continuation's certificate: known (a budgeted
     /// fallback's), its flight's (one track), or flown.
     fn certify_candidate(
@@ -211,7 +242,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         match cand.cert {
             Some(known) => known,
             None if c.len() == 1 => self.certify_one(sc, bottom, state, &cand.flown, flights),
-            None => self.tube.certify(sc, bottom, c, flights),
+            None => self.tube.certify(sc, bottom, c, (cand.h_safe, flights)),
         }
     }
 
@@ -254,6 +285,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The last certified point on the path `a + t (c − a)`, `t ∈ [0, 1]`,
     /// from the certified anchor `a` towards the candidate `c`.
+    ///
+    /// The root search flies only the *critical* worlds (those that have
+    /// set a certificate's least altitude, [`Tube::critical`]): their
+    /// least altitude bounds the certificate from above, so a point they
+    /// reject is rejected. The point found is then certified in every
+    /// world; if another world rejects it, that world becomes critical, the
+    /// point becomes the bracket's unsafe end and the search goes on (at
+    /// most [`SEARCH_ROUNDS`] rounds, then the last certified point).
     fn search(
         &self,
         sc: &Scenario<'_, N>,
@@ -278,31 +317,58 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             width: SEARCH_WIDTH,
             steps: self.cfg.bisection_steps,
         };
-        let (good, bad) = (
-            (0.0, Some(cert_a.all - h_safe)),
-            (1.0, Some(cert_c.all - h_safe)),
-        );
+        let mut good = (0.0, cert_a);
+        let mut bad = (1.0, cert_c.all - h_safe);
+        for _ in 0..SEARCH_ROUNDS {
+            let ends = ((good.0, good.1.all - h_safe), bad);
+            let ends = (ends, h_safe);
+            let Some(t) = self.screened_root(sc, bottom, (&at, len), ends, rule, flights) else {
+                break;
+            };
+            if !self.budget.afford(*flights) {
+                break;
+            }
+            let d = at(t);
+            let d = d.get(..len).unwrap_or(&[]);
+            let cert = self.tube.certify(sc, bottom, d, (h_safe, &mut *flights));
+            if cert.all >= h_safe {
+                good = (t, cert);
+                break;
+            }
+            bad = (t, cert.all - h_safe);
+        }
+        Chosen {
+            depths: if good.0 > 0.0 { at(good.0) } else { *a },
+            len,
+            cert: good.1,
+            searched: true,
+        }
+    }
+
+    /// One round of [`Planner::search`]: the boundary of the critical
+    /// worlds' certificate between `good` and `bad` (`t` with its margin
+    /// over `h_safe`, m), or `None` where it did not move off `good`.
+    fn screened_root<F: Fn(f32) -> [f32; MAX_TRACKS]>(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (at, len): (&F, usize),
+        ((good, bad), h_safe): (Bracket, f32),
+        rule: RootTol,
+        flights: &mut u32,
+    ) -> Option<f32> {
         let budget = self.budget;
-        let r = root::safe_boundary(good, bad, rule, |t| {
+        let mask = self.tube.critical();
+        let r = root::safe_boundary((good.0, Some(good.1)), (bad.0, Some(bad.1)), rule, |t| {
             if !budget.afford(*flights) {
                 return Err(());
             }
             let d = at(t);
-            let cert = self
-                .tube
-                .certify(sc, bottom, d.get(..len).unwrap_or(&[]), flights);
-            Ok::<_, ()>((cert.all - h_safe, cert))
+            let d = d.get(..len).unwrap_or(&[]);
+            let cert = self.tube.certify_only(sc, bottom, d, mask, flights);
+            Ok::<_, ()>((cert.all - h_safe, ()))
         });
-        let (t, cert) = match r {
-            Ok(root) => (root.z, root.at.unwrap_or(cert_a)),
-            Err(()) => (0.0, cert_a),
-        };
-        Chosen {
-            depths: if t > 0.0 { at(t) } else { *a },
-            len,
-            cert,
-            searched: true,
-        }
+        r.ok().map(|root| root.z).filter(|&t| t > good.0)
     }
 
     /// The certificate of the candidate's track alone: its nominal flight
@@ -318,7 +384,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if nominal_only(sc, bottom, &self.tube, state) {
             self.tube.of_flight(flown.score.min_altitude())
         } else {
-            self.tube.certify(sc, bottom, &[flown.depth], flights)
+            self.tube
+                .certify(sc, bottom, &[flown.depth], (f32::NEG_INFINITY, flights))
         }
     }
 

@@ -23,11 +23,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
         depths: &[f32],
-        flights: &mut u32,
+        (floor, flights): (f32, &mut u32),
         spare: u32,
     ) -> Certificate {
         if self.budget.afford(flights.saturating_add(spare)) {
-            self.tube.certify(sc, bottom, depths, flights)
+            self.tube.certify(sc, bottom, depths, (floor, flights))
         } else {
             Certificate::NONE
         }
@@ -99,6 +99,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             .map(|c| Certificate {
                 first: c.all,
                 all: c.all,
+                partial: false,
             });
         let tail = if nominal { 1 } else { w.saturating_add(1) };
         let certify = if nominal && (len == 1 || !guaranteed) {
@@ -328,6 +329,7 @@ fn fly_line<const N: usize>(
     let cert = Certificate {
         first: f.score.min_altitude(),
         all,
+        partial: false,
     };
     Ok((f, cert))
 }
