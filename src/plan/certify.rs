@@ -12,6 +12,16 @@
 //! predicted (a closed loop replanning from a measured state), every world
 //! starts again from that state.
 //!
+//! **What it costs.** A certificate that holds flies every world to the
+//! line's end. One that fails need not: the world that set the last
+//! certificate's least altitude flies first, and the first world below the
+//! floor asked for ends the certificate (`partial`: its altitudes are
+//! upper bounds, and `commit.rs` flies the rest before a partial
+//! certificate is ever committed or reported). The continuation search of
+//! `commit.rs` finds its point in the *critical* worlds alone (every world
+//! that has set a certificate's least altitude since the tube restarted,
+//! [`Tube::critical`]) and then certifies that point in every world.
+//!
 //! The vehicle part of the certificate is sampled ([`World::corners`]: the
 //! corners and interior levels of the declared box). Between the samples
 //! the flight can dip lower where the autopilot saturates (measured: up
@@ -141,7 +151,7 @@ impl<const N: usize> Tube<N> {
                 let mut score = [TrackScore::default()];
                 let next = sc
                     .in_world(w, bottom)
-                    .and_then(|scw| scw.simulate(st, self.track, &[depth], &mut score, |_| {}));
+                    .and_then(|scw| scw.fly(st, self.track, &[depth], &mut score));
                 match next {
                     Ok(n) => *st = n,
                     Err(_) => {
@@ -273,7 +283,9 @@ impl<const N: usize> Tube<N> {
 /// on the first track, and to the end (`-inf` from the track on which a
 /// flight fails). Each track's altitude less `margin` also lowers the
 /// matching entry of `per_track` (which may be shorter, or empty).
+/// (Not inlined: its callers share one copy of the flight.)
 #[allow(clippy::too_many_arguments)]
+#[inline(never)]
 fn fly_world<const N: usize>(
     sc: &Scenario<'_, N>,
     w: &World,
@@ -292,7 +304,7 @@ fn fly_world<const N: usize>(
     // One flight of the line, flown track by track (runs chain exactly).
     *flights = flights.saturating_add(1);
     for (j, &z) in depths.iter().enumerate() {
-        let flown = scw.simulate(&state, track.saturating_add(j), &[z], &mut score, |_| {});
+        let flown = scw.fly(&state, track.saturating_add(j), &[z], &mut score);
         let h = match flown {
             Ok(next) => {
                 state = next;

@@ -322,15 +322,22 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         for _ in 0..SEARCH_ROUNDS {
             let ends = ((good.0, good.1.all - h_safe), bad);
             let ends = (ends, h_safe);
-            let Some(t) = self.screened_root(sc, bottom, (&at, len), ends, rule, flights) else {
+            let Some((t, screened)) =
+                self.screened_root(sc, bottom, (&at, len), ends, rule, flights)
+            else {
                 break;
             };
-            if !self.budget.afford(*flights) {
-                break;
-            }
-            let d = at(t);
-            let d = d.get(..len).unwrap_or(&[]);
-            let cert = self.tube.certify(sc, bottom, d, (h_safe, &mut *flights));
+            // (Every world flown already when all are critical.)
+            let cert = if screened.partial {
+                if !self.budget.afford(*flights) {
+                    break;
+                }
+                let d = at(t);
+                let d = d.get(..len).unwrap_or(&[]);
+                self.tube.certify(sc, bottom, d, (h_safe, &mut *flights))
+            } else {
+                screened
+            };
             if cert.all >= h_safe {
                 good = (t, cert);
                 break;
@@ -347,7 +354,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// One round of [`Planner::search`]: the boundary of the critical
     /// worlds' certificate between `good` and `bad` (`t` with its margin
-    /// over `h_safe`, m), or `None` where it did not move off `good`.
+    /// over `h_safe`, m) with that certificate, or `None` where it did not
+    /// move off `good`.
     fn screened_root<F: Fn(f32) -> [f32; MAX_TRACKS]>(
         &self,
         sc: &Scenario<'_, N>,
@@ -356,7 +364,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         ((good, bad), h_safe): (Bracket, f32),
         rule: RootTol,
         flights: &mut u32,
-    ) -> Option<f32> {
+    ) -> Option<(f32, Certificate)> {
         let budget = self.budget;
         let mask = self.tube.critical();
         let r = root::safe_boundary((good.0, Some(good.1)), (bad.0, Some(bad.1)), rule, |t| {
@@ -366,9 +374,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let d = at(t);
             let d = d.get(..len).unwrap_or(&[]);
             let cert = self.tube.certify_only(sc, bottom, d, mask, flights);
-            Ok::<_, ()>((cert.all - h_safe, ()))
+            Ok::<_, ()>((cert.all - h_safe, cert))
         });
-        r.ok().map(|root| root.z).filter(|&t| t > good.0)
+        let root = r.ok()?;
+        root.at.filter(|_| root.z > good.0).map(|c| (root.z, c))
     }
 
     /// The certificate of the candidate's track alone: its nominal flight

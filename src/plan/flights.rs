@@ -36,7 +36,7 @@ impl<const N: usize> Flights<'_, '_, N> {
         let mut score = [TrackScore::default()];
         let next = self
             .sc
-            .simulate(st, self.track.saturating_add(j), &[z], &mut score, |_| {})?;
+            .fly(st, self.track.saturating_add(j), &[z], &mut score)?;
         Ok((score[0], next))
     }
 }

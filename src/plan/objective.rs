@@ -94,7 +94,7 @@ impl<const N: usize> PlanObjective<'_, N> {
             .get_mut(..self.count)
             .ok_or(Stop::Sim(SimError::TrackRange))?;
         self.sc
-            .simulate(self.start, self.track, used, sc, |_| {})
+            .fly(self.start, self.track, used, sc)
             .map_err(Stop::Sim)?;
         let j: f32 = sc.iter().map(TrackScore::j).sum();
         let violation: f32 = sc.iter().map(TrackScore::violation).sum();

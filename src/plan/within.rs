@@ -305,7 +305,7 @@ fn fly_line<const N: usize>(
     let mut all = f32::INFINITY;
     for (j, &z) in depths.iter().enumerate() {
         let mut score = [TrackScore::default()];
-        match sc.simulate(&st, track.saturating_add(j), &[z], &mut score, |_| {}) {
+        match sc.fly(&st, track.saturating_add(j), &[z], &mut score) {
             Ok(next) => {
                 let s = score[0];
                 all = all.min(s.min_altitude());

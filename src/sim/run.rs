@@ -101,6 +101,24 @@ impl<const N: usize> Scenario<'_, N> {
         )
     }
 
+    /// [`Scenario::simulate`] with no observer: the one out-of-line copy
+    /// of the loop that every plain flight of the planner shares (each
+    /// caller's own `|_| {}` would otherwise be a copy of its own, about
+    /// 5 KB of flash each on a Cortex-M4F).
+    ///
+    /// # Errors
+    /// As [`Scenario::simulate`].
+    #[inline(never)]
+    pub(crate) fn fly(
+        &self,
+        start: &VehicleState<N>,
+        first_track: usize,
+        depths: &[f32],
+        scores: &mut [TrackScore],
+    ) -> Result<VehicleState<N>, SimError> {
+        self.simulate(start, first_track, depths, scores, |_| {})
+    }
+
     /// The one simulation loop; see the module docs. `FAST` selects the
     /// in-segment fast path (always, but for the test that compares the
     /// two paths).

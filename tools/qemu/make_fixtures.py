@@ -10,6 +10,8 @@ data/bathymetry/*.csv, and writes
 
     tests/qemu_support/fixtures.rs   every fixture case, for tests/qemu_fixtures.rs
     tests/qemu_support/monterey.rs   the paper's line us_monterey_canyon_1
+    tests/qemu_support/monterey_2.rs, monterey_3.rs   the other Monterey lines
+                                     (examples/qemu_lines.rs)
 
 Values reach the target exactly as the host tests see them:
 - inputs the host converts to f32 (`json_f64 as f32`: plant coefficients,
@@ -349,14 +351,13 @@ def gen_fixtures():
     return "".join(o)
 
 
-def gen_monterey():
-    name = "us_monterey_canyon_1"
+def gen_monterey(name="us_monterey_canyon_1", title="The paper's line"):
     xs, bs = read_csv_profile(name)
     wps = read_csv_waypoints(name)
     return (
         HEADER.format(sources=f"data/bathymetry/{name}.csv and .waypoints.csv")
         + "#![allow(dead_code, clippy::all)]\n\n"
-        + f"//! The paper's line `{name}` (GEBCO 2021 grid, not for navigation),\n"
+        + f"//! {title} `{name}` (GEBCO 2021 grid, not for navigation),\n"
         + "//! verbatim from the bundled CSVs.\n\n"
         + f"/// Samples in the profile.\npub const SAMPLES: usize = {len(xs)};\n\n"
         + f"/// Along-track position of each bottom sample, m.\npub const X: [f32; SAMPLES] = [\n"
@@ -374,6 +375,8 @@ def main():
     outputs = {
         os.path.join(OUT, "fixtures.rs"): gen_fixtures(),
         os.path.join(OUT, "monterey.rs"): gen_monterey(),
+        os.path.join(OUT, "monterey_2.rs"): gen_monterey("us_monterey_canyon_2", "The line"),
+        os.path.join(OUT, "monterey_3.rs"): gen_monterey("us_monterey_canyon_3", "The line"),
     }
     stale = []
     for path, text in outputs.items():
