@@ -90,7 +90,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         } else {
             let mut depths = [0.0; MAX_TRACKS];
             depths[0] = cand.flown.depth;
-            let cert = self.certify_one(sc, bottom, state, &cand.flown, &mut flights);
+            let at = (f32::NEG_INFINITY, &mut flights);
+            let cert = self.certify_one(sc, bottom, (state, &cand.flown), at);
             Chosen {
                 depths,
                 len: 1,
@@ -241,7 +242,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let c = c.get(..len).unwrap_or(&[]);
         match cand.cert {
             Some(known) => known,
-            None if c.len() == 1 => self.certify_one(sc, bottom, state, &cand.flown, flights),
+            // (In full: the one-track certificate is the search's end.)
+            None if c.len() == 1 => {
+                let at = (f32::NEG_INFINITY, flights);
+                self.certify_one(sc, bottom, (state, &cand.flown), at)
+            }
             None => self.tube.certify(sc, bottom, c, (cand.h_safe, flights)),
         }
     }
@@ -381,20 +386,20 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// The certificate of the candidate's track alone: its nominal flight
-    /// when that is the only world over the map, else the worlds' flights.
+    /// when that is the only world over the map, else the worlds' flights
+    /// (partial below `floor`, m, see [`Tube::certify`]).
     fn certify_one(
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
-        state: &VehicleState<N>,
-        flown: &Flown<N>,
-        flights: &mut u32,
+        (state, flown): (&VehicleState<N>, &Flown<N>),
+        (floor, flights): (f32, &mut u32),
     ) -> Certificate {
         if nominal_only(sc, bottom, &self.tube, state) {
             self.tube.of_flight(flown.score.min_altitude())
         } else {
             self.tube
-                .certify(sc, bottom, &[flown.depth], (f32::NEG_INFINITY, flights))
+                .certify(sc, bottom, &[flown.depth], (floor, flights))
         }
     }
 
