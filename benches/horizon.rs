@@ -398,6 +398,23 @@ fn reference_best() -> Option<f64> {
     v.get("best_safe_J")?.as_f64()
 }
 
+/// The replicated start against the planner's: `Φ = Σ J + μ V` at the
+/// beam scan's point, and the first entry of the planner's history (its
+/// objective at its start point).
+fn start_check(sc: &Scenario<'_, 3>, st: &VehicleState<3>) {
+    let pen = sc.with_penalty_altitude(sc.mission().min_altitude() + PENALTY_MARGIN);
+    let (z0, flights) = beam_start(&pen, st, search_box(sc, st));
+    let e = pen.evaluate::<H>(st, 0, &z0).unwrap();
+    let phi = f64::from(e.j) + MU0 * f64::from(e.violation);
+    let mut p = Planner::<H>::new(PlannerConfig::default()).unwrap();
+    p.plan(sc, st, 0).unwrap();
+    let first = p.history().first().copied().unwrap_or(f32::NAN);
+    eprintln!(
+        "start (replicated beam scan, {flights} flights): {z0:.2?}, Φ = {phi:.7e} m³; \
+         the planner's first Φ: {first:.7e} m³"
+    );
+}
+
 /// The tolerance sweep and the table (stderr); returns `open`'s residual.
 fn report(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> f64 {
     let h_safe = sc.mission().min_altitude() + SAFETY_MARGIN;
@@ -455,6 +472,7 @@ fn benches(c: &mut Criterion) {
     let l = line();
     let sc = scenario(&l);
     let st = sc.start_state(sc.default_initial_depth());
+    start_check(&sc, &st);
     let eps = report(&sc, &st);
     let mut g = c.benchmark_group("horizon");
     g.sample_size(10);
