@@ -220,10 +220,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if let Some(j) = r.at
             && j < j0
             && r.z > z0
+            && let Some(slot) = self.work.z.first_mut()
         {
-            if let Some(slot) = self.work.z.first_mut() {
-                *slot = r.z;
-            }
+            *slot = r.z;
         }
     }
 
