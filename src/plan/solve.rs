@@ -39,18 +39,8 @@ fn horizon_flight<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     z: &[f32; K],
 ) -> Result<(f32, f32, f32), Stop> {
-    if obj.evaluations >= obj.budget {
-        return Err(Stop::Budget);
-    }
-    obj.evaluations = obj.evaluations.saturating_add(1);
-    let used = z.get(..obj.count).ok_or(Stop::Sim(SimError::TrackRange))?;
-    let mut scores = [TrackScore::default(); K];
-    let sc = scores
-        .get_mut(..obj.count)
-        .ok_or(Stop::Sim(SimError::TrackRange))?;
-    obj.sc
-        .simulate(obj.start, obj.track, used, sc, |_| {})
-        .map_err(Stop::Sim)?;
+    let scores = obj.flight(z)?;
+    let sc = scores.get(..obj.count).unwrap_or(&[]);
     let j: f32 = sc.iter().map(TrackScore::j).sum();
     let first = sc.first().map_or(f32::INFINITY, TrackScore::min_altitude);
     let later = sc
