@@ -116,6 +116,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
         let iterations =
             self.escape_plateaus(&mut obj, (s.h, &s.bounds), first_step, iterations)?;
+        self.committed_to_boundary(&mut obj, (s.h, &s.bounds));
         fl.count = fl.count.saturating_add(obj.evaluations);
         let spent = obj.evaluations >= obj.budget;
         let (f, found) = self.verify(&mut fl, &s, (obj.last_flight, spent), &mut scan)?;

@@ -77,10 +77,10 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
 }
 
 impl<const N: usize> PlanObjective<'_, N> {
-    /// `Φ(ζ)` alone, by a plain flight of the horizon (no tangents): what
-    /// a scan needs. Counts as an evaluation, within the budget; leaves
-    /// the last point's records (`last_*`) alone.
-    pub fn flight_value<const K: usize>(&mut self, z: &[f32; K]) -> Result<f32, Stop> {
+    /// The scores of a plain flight of the horizon `z` (no tangents; the
+    /// entries past `count` default). Counts as an evaluation, within the
+    /// budget; leaves the last point's records (`last_*`) alone.
+    pub fn flight<const K: usize>(&mut self, z: &[f32; K]) -> Result<[TrackScore; K], Stop> {
         if self.tripped.is_some() {
             return Err(Stop::LeftSafeSet);
         }
@@ -96,6 +96,14 @@ impl<const N: usize> PlanObjective<'_, N> {
         self.sc
             .fly(self.start, self.track, used, sc)
             .map_err(Stop::Sim)?;
+        Ok(scores)
+    }
+
+    /// `Φ(ζ)` alone, by a plain flight of the horizon (no tangents): what
+    /// a scan needs. As [`Self::flight`].
+    pub fn flight_value<const K: usize>(&mut self, z: &[f32; K]) -> Result<f32, Stop> {
+        let scores = self.flight(z)?;
+        let sc = scores.get(..self.count).unwrap_or(&[]);
         let j: f32 = sc.iter().map(TrackScore::j).sum();
         let violation: f32 = sc.iter().map(TrackScore::violation).sum();
         let phi = j + self.mu * violation;

@@ -1,9 +1,11 @@
 //! The penalized solve of a horizon: one optimizer run merged onto the
 //! planner's workspace, the sequential penalty stages (N&W §17.1: `μ`
-//! ×100 while the optimum still violates), and the plateau escape.
+//! ×100 while the optimum still violates), the plateau escape, and the
+//! committed track moved onto the certified boundary.
 
+use crate::optim::root::{self, RootTol};
 use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
-use crate::sim::SimError;
+use crate::sim::{SimError, TrackScore};
 
 use super::objective::{PlanObjective, Stop};
 use super::scan::grid;
@@ -11,6 +13,43 @@ use super::{Method, PlanError, Planner};
 
 /// Factor on `μ` between penalty stages.
 const PENALTY_GROWTH: f32 = 100.0;
+
+/// The committed track's boundary search stops when the horizon's least
+/// altitude is within this share of `h_r − h_a` of the certified altitude
+/// (as the single track's, `fallback.rs`), ...
+const BOUNDARY_SHARE: f32 = 0.002;
+/// ... clamped to this range, m ...
+const BOUNDARY_ALTITUDE: [f32; 2] = [1e-3, 0.02];
+/// ... or when its bracket is this narrow, m.
+const BOUNDARY_DEPTH: f32 = 1e-3;
+
+/// Share of the penalty margin `m_p` above `h_a` that the later tracks of
+/// the horizon keep when the committed depth moves (or what they had, if
+/// less). With none kept, the next calls start on the boundary and the
+/// last, single-track call can lose the safe depths of its track (Medes 1:
+/// `J` +40 %); with all of it, the committed depth cannot move wherever the
+/// later tracks are held too.
+const LATER_SHARE: f32 = 0.25;
+
+/// `(Σ J, least altitude of the first track, least altitude of the later
+/// ones)` of the horizon `z` by a plain flight (m³, m, m; `+∞` with no
+/// later track), counted in `obj`'s evaluations, within its
+/// budget.
+fn horizon_flight<const N: usize, const K: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    z: &[f32; K],
+) -> Result<(f32, f32, f32), Stop> {
+    let scores = obj.flight(z)?;
+    let sc = scores.get(..obj.count).unwrap_or(&[]);
+    let j: f32 = sc.iter().map(TrackScore::j).sum();
+    let first = sc.first().map_or(f32::INFINITY, TrackScore::min_altitude);
+    let later = sc
+        .iter()
+        .skip(1)
+        .map(TrackScore::min_altitude)
+        .fold(f32::INFINITY, f32::min);
+    Ok((j, first, later))
+}
 
 /// How [`Planner::optimize_onto`] merges a run.
 #[derive(Clone, Copy)]
@@ -104,6 +143,77 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         }
         Ok(iterations)
+    }
+
+    /// The committed (first) depth of a constrained horizon moved onto the
+    /// certified boundary. The horizon is penalized below `h_a + m_p`, so a
+    /// first track the constraint holds sits up to `m_p` above the
+    /// certified altitude `h_a + m_s`, and the commit keeps it there (only
+    /// an unsafe candidate goes to the boundary search): on the shallow
+    /// sites, where `m_p` is a large share of `h_r − h_a`, that costs
+    /// whole percents of `J`. When the first track's least altitude is
+    /// below `h_a + 2 m_p` and the horizon is safe, the first depth is
+    /// searched deeper, the later depths held, for the point where the
+    /// first track's least altitude reaches `h_a + m_s` or the later
+    /// tracks' `h_a + LATER_SHARE m_p` (or what it was, if lower): a root
+    /// search from the safe side; it is kept where `Σ J` is lower (the
+    /// optimizer's objective and history stay the optimizer's). Plain
+    /// flights of the horizon, counted in the objective's evaluations,
+    /// within its budget.
+    pub(super) fn committed_to_boundary(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        (h, bounds): (usize, &Bounds<K>),
+    ) {
+        let (Some(&z0), Some(&hi)) = (self.work.z.first(), bounds.hi.first()) else {
+            return;
+        };
+        if h <= 1 || obj.mu <= 0.0 || z0 >= hi {
+            return;
+        }
+        let m = *obj.sc.mission();
+        let h_safe = m.min_altitude() + self.cfg.safety_margin;
+        let band = obj.sc.penalty_altitude() + self.cfg.penalty_margin;
+        let tol = (BOUNDARY_SHARE * (m.reference_altitude() - m.min_altitude()))
+            .clamp(BOUNDARY_ALTITUDE[0], BOUNDARY_ALTITUDE[1]);
+        let base = self.work.z;
+        let Ok((j0, first, later)) = horizon_flight(obj, &base) else {
+            return;
+        };
+        if first < h_safe + tol || first >= band || later < h_safe {
+            return;
+        }
+        // The later tracks keep part of their margin: the next calls start
+        // from their depths.
+        let floor = later.min(m.min_altitude() + LATER_SHARE * self.cfg.penalty_margin);
+        let margin = |a: f32, b: f32| (a - h_safe).min(b - floor);
+        // Altitude falls at most a metre per metre of reference depth: twice
+        // the headroom deeper is past the boundary unless the flight there
+        // is held by something else (then that depth itself is tried).
+        let bad = (z0 + 2.0 * (first - h_safe) + tol).min(hi);
+        let rule = RootTol {
+            tol,
+            width: BOUNDARY_DEPTH,
+            steps: self.cfg.bisection_steps,
+        };
+        let good = (z0, Some(margin(first, later)));
+        let found = root::safe_boundary(good, (bad, None), rule, |t| {
+            let mut z = base;
+            if let Some(slot) = z.first_mut() {
+                *slot = t;
+            }
+            horizon_flight(obj, &z).map(|(j, a, b)| (margin(a, b), j))
+        });
+        let Ok(r) = found else {
+            return;
+        };
+        if let Some(j) = r.at
+            && j < j0
+            && r.z > z0
+            && let Some(slot) = self.work.z.first_mut()
+        {
+            *slot = r.z;
+        }
     }
 
     /// The best point of a scan of coordinate `j` over its box when its
