@@ -41,8 +41,19 @@ use crate::model::{ProfileView, Uncertainty, Vehicle};
 use crate::num::DEG;
 use crate::sim::{MAX_WORLDS, Scenario, SimError, TrackScore, VehicleState, World};
 
-// The critical worlds are the bits of a `u128`.
-const _: () = assert!(MAX_WORLDS <= 128);
+/// A set of worlds, bit `i % 32` of word `i / 32` for world `i` (words,
+/// not a `u128`, so that the planner keeps the alignment of its `f32`s
+/// and `u32`s: the C interface stores it in 8-byte-aligned memory).
+pub(super) type Worlds = [u32; 3];
+
+const _: () = assert!(MAX_WORLDS <= 96);
+
+/// Whether world `i` is in `set`.
+fn has(set: &Worlds, i: usize) -> bool {
+    let (word, bit) = (i / 32, i % 32);
+    set.get(word)
+        .is_some_and(|w| (w >> u32::try_from(bit).unwrap_or(0)) & 1 == 1)
+}
 
 /// The time over which the vehicle margin accumulates, s (module docs).
 const MARGIN_TIME: f32 = 15.0;
@@ -68,8 +79,8 @@ pub(super) struct Tube<const N: usize> {
     /// flown first, so that an uncertifiable line is found in one flight.
     worst: Cell<usize>,
     /// The worlds that have set a certificate's least altitude since the
-    /// tube was last restarted (bit `i`: world `i`).
-    critical: Cell<u128>,
+    /// tube was last restarted ([`Worlds`]).
+    critical: Cell<Worlds>,
     /// The track those states start, and the nominal state they go with.
     track: usize,
     nominal: Option<VehicleState<N>>,
@@ -82,7 +93,7 @@ impl<const N: usize> Default for Tube<N> {
             margin: 0.0,
             states: [VehicleState::trimmed(0.0, 0.0); MAX_WORLDS],
             worst: Cell::new(0),
-            critical: Cell::new(0),
+            critical: Cell::new([0; 3]),
             track: 0,
             nominal: None,
         }
@@ -121,7 +132,7 @@ impl<const N: usize> Tube<N> {
         if !kept {
             self.worlds = worlds;
             self.states = [*state; MAX_WORLDS];
-            self.critical.set(0);
+            self.critical.set([0; 3]);
             self.track = track;
             self.nominal = Some(*state);
         }
@@ -233,19 +244,23 @@ impl<const N: usize> Tube<N> {
 
     /// Adds the worst world to the critical ones.
     fn mark_worst(&self) {
-        let bit = 1u128.checked_shl(u32::try_from(self.worst.get()).unwrap_or(u32::MAX));
-        self.critical.set(self.critical.get() | bit.unwrap_or(0));
+        let i = self.worst.get();
+        let mut set = self.critical.get();
+        if let Some(w) = set.get_mut(i / 32) {
+            *w |= 1 << u32::try_from(i % 32).unwrap_or(0);
+        }
+        self.critical.set(set);
     }
 
-    /// The critical worlds (bit `i`: world `i`), never none: the worst
+    /// The critical worlds ([`Worlds`]), never none: the worst
     /// world at least.
-    pub fn critical(&self) -> u128 {
+    pub fn critical(&self) -> Worlds {
         self.mark_worst();
         self.critical.get()
     }
 
     /// Flies `depths` as [`Tube::certify`] does, in the worlds of `mask`
-    /// only (bit `i`: world `i`): the certificate is `partial` unless the
+    /// only ([`Worlds`]): the certificate is `partial` unless the
     /// mask holds every world; its altitudes bound the full one's from
     /// above.
     pub fn certify_only(
@@ -253,7 +268,7 @@ impl<const N: usize> Tube<N> {
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
         depths: &[f32],
-        mask: u128,
+        mask: Worlds,
         flights: &mut u32,
     ) -> Certificate {
         let mut c = Certificate {
@@ -262,11 +277,7 @@ impl<const N: usize> Tube<N> {
             partial: false,
         };
         for (i, (w, st)) in self.worlds.iter().zip(self.states.iter()).enumerate() {
-            let on = u32::try_from(i)
-                .ok()
-                .and_then(|i| mask.checked_shr(i))
-                .is_some_and(|m| m & 1 == 1);
-            if !on {
+            if !has(&mask, i) {
                 c.partial = true;
                 continue;
             }
