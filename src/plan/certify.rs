@@ -377,3 +377,50 @@ pub fn certify_line<const N: usize>(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::{Mission, Profile, Waypoints};
+
+    /// A partial certificate bounds the full one from above, and the
+    /// critical worlds, or all of them, give the full certificate's value
+    /// where they hold the worst world.
+    #[test]
+    fn partial_and_screened_certificates_bound_the_full_one() {
+        let v = Vehicle::c_auv4().unwrap();
+        let p =
+            Profile::<8>::new(&[0.0, 400.0, 700.0, 1500.0], &[300.0, 300.0, 180.0, 200.0]).unwrap();
+        let w = Waypoints::<4>::new(&[0.0, 600.0, 1400.0]).unwrap();
+        let u = Uncertainty::new(0.0, 0.0, 0.0, 0.05, 1.0, 0.05).unwrap();
+        let sc = Scenario::new(&v, &p, &w, Mission::default().with_uncertainty(u)).unwrap();
+        let start = sc.start_state(220.0);
+        let mut tube = Tube::default();
+        let worlds = World::corners(&v, &u);
+        let n = worlds.len();
+        tube.prepare((worlds, vehicle_margin(&v, &u)), &start, 0);
+        let mut flights = 0;
+        let depths = [230.0, 110.0];
+        let full = tube.certify(&sc, p.view(), &depths, (f32::NEG_INFINITY, &mut flights));
+        assert!(!full.partial && full.all.is_finite() && n == MAX_WORLDS);
+        assert_eq!(flights as usize, n);
+        // Asked for a floor above it: stops after the worst world, first.
+        let mut few = 0;
+        let part = tube.certify(&sc, p.view(), &depths, (full.all + 1.0, &mut few));
+        assert!(part.partial && few == 1, "{part:?} after {few} flights");
+        assert_eq!(part.all.to_bits(), full.all.to_bits());
+        // The critical worlds hold the worst one: the same least altitude,
+        // from fewer flights; all worlds: the full certificate itself.
+        let mut screened = 0;
+        let c = tube.certify_only(&sc, p.view(), &depths, tube.critical(), &mut screened);
+        assert!(c.partial && (screened as usize) < n);
+        assert_eq!(c.all.to_bits(), full.all.to_bits());
+        assert!(c.first >= full.first);
+        let all = tube.certify_only(&sc, p.view(), &depths, [u32::MAX; 3], &mut screened);
+        assert!(!all.partial);
+        assert_eq!(
+            (all.all.to_bits(), all.first.to_bits()),
+            (full.all.to_bits(), full.first.to_bits())
+        );
+    }
+}
