@@ -55,22 +55,20 @@
 )]
 #![allow(clippy::arithmetic_side_effects, missing_docs)]
 
+mod common;
+
 use std::cell::{Cell, RefCell};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use auvnav::{
-    Mission, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle, VehicleState,
-    Waypoints,
-};
+use auvnav::{Planner, PlannerConfig, Scenario, TrackScore, VehicleState};
+use common::line;
 use criterion::{Criterion, criterion_group};
 use optimization_engine::SolverError;
 use optimization_engine::alm::{AlmCache, AlmOptimizer, AlmProblem, NO_MAPPING, NO_SET};
 use optimization_engine::constraints::Rectangle;
 use optimization_engine::core::panoc::PANOCCache;
 
-const PROFILE: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.csv");
-const WAYPOINTS: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.waypoints.csv");
 /// Tracks of the horizon.
 const H: usize = 5;
 /// Penalty margin `m_p` and safety margin `m_s` of `PlannerConfig::default`, m.
@@ -92,29 +90,6 @@ const PENALTY_GROWTH: f64 = 100.0;
 const LBFGS_MEMORY: usize = 5;
 /// PANOC's fixed-point residuals tried, m, loosest first.
 const EPSILONS: [f64; 5] = [1e-2, 3e-3, 1e-3, 3e-4, 1e-4];
-
-struct Line {
-    vehicle: Vehicle<3>,
-    profile: Profile<256>,
-    waypoints: Waypoints<8>,
-}
-
-fn line() -> Line {
-    let col = |l: &str, i: usize| -> f32 { l.split(',').nth(i).unwrap().parse().unwrap() };
-    let rows: Vec<&str> = PROFILE.lines().skip(1).collect();
-    let x: Vec<f32> = rows.iter().map(|l| col(l, 0)).collect();
-    let b: Vec<f32> = rows.iter().map(|l| col(l, 1)).collect();
-    let wps: Vec<f32> = WAYPOINTS.lines().skip(1).map(|l| col(l, 1)).collect();
-    Line {
-        vehicle: Vehicle::c_auv4().unwrap(),
-        profile: Profile::new(&x, &b).unwrap(),
-        waypoints: Waypoints::new(&wps).unwrap(),
-    }
-}
-
-fn scenario(l: &Line) -> Scenario<'_, 3> {
-    Scenario::new(&l.vehicle, &l.profile, &l.waypoints, Mission::default()).unwrap()
-}
 
 /// A solution: the horizon's depths, `Σ J` and least altitude flown again,
 /// and what it cost.
@@ -482,7 +457,7 @@ fn report(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f64, f64) {
 
 fn benches(c: &mut Criterion) {
     let l = line();
-    let sc = scenario(&l);
+    let sc = l.scenario();
     let st = sc.start_state(sc.default_initial_depth());
     start_check(&sc, &st);
     let (eps, best) = report(&sc, &st);

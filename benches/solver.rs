@@ -35,6 +35,8 @@
 )]
 #![allow(clippy::arithmetic_side_effects, missing_docs)]
 
+mod common;
+
 use std::cell::Cell;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -43,50 +45,13 @@ use argmin::core::{CostFunction, Executor, Gradient};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::BFGS;
 use auvnav::optim::{self, BfgsConfig, Bounds, GdConfig, Objective, Tolerances};
-use auvnav::{Mission, Profile, Scenario, TrackScore, Vehicle, VehicleState, Waypoints};
+use auvnav::{Scenario, TrackScore, VehicleState};
+use common::line;
 use criterion::{Criterion, Throughput, criterion_group};
 
-const PROFILE: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.csv");
-const WAYPOINTS: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.waypoints.csv");
 const TRACK: usize = 1;
 const GRAD_TOL: f32 = 1.0;
 const REL_TOL: f32 = 1e-5;
-
-struct Setup {
-    vehicle: Vehicle<3>,
-    profile: Profile<256>,
-    waypoints: Waypoints<8>,
-}
-
-fn setup() -> Setup {
-    let rows: Vec<(f32, f32)> = PROFILE
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let mut it = l.split(',');
-            (
-                it.next().unwrap().parse().unwrap(),
-                it.next().unwrap().parse().unwrap(),
-            )
-        })
-        .collect();
-    let x: Vec<f32> = rows.iter().map(|r| r.0).collect();
-    let b: Vec<f32> = rows.iter().map(|r| r.1).collect();
-    let wps: Vec<f32> = WAYPOINTS
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').nth(1).unwrap().parse().unwrap())
-        .collect();
-    Setup {
-        vehicle: Vehicle::c_auv4().unwrap(),
-        profile: Profile::new(&x, &b).unwrap(),
-        waypoints: Waypoints::new(&wps).unwrap(),
-    }
-}
-
-fn scenario(s: &Setup) -> Scenario<'_, 3> {
-    Scenario::new(&s.vehicle, &s.profile, &s.waypoints, Mission::default()).unwrap()
-}
 
 /// The state at waypoint 1 after flying track 1 at 866.86 m.
 fn start(sc: &Scenario<'_, 3>) -> VehicleState<3> {
@@ -238,8 +203,8 @@ fn solve_numeris(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> (f32, u32) {
 }
 
 fn benches(c: &mut Criterion) {
-    let s = setup();
-    let sc = scenario(&s);
+    let s = line();
+    let sc = s.scenario();
     let st = start(&sc);
 
     let mut g = c.benchmark_group("solve");
@@ -310,8 +275,8 @@ fn time<T>(budget: Duration, mut f: impl FnMut() -> T) -> Duration {
 }
 
 fn ratios() {
-    let s = setup();
-    let sc = scenario(&s);
+    let s = line();
+    let sc = s.scenario();
     let st = start(&sc);
     let line = sc.start_state(sc.default_initial_depth());
     let plan5 = [866.86_f32, 680.0, 544.0, 151.0, 50.0];

@@ -11,11 +11,11 @@
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, missing_docs)]
 #![allow(clippy::arithmetic_side_effects)]
 
+mod common;
+
 use std::hint::black_box;
 
-use auvnav::{Mission, Profile, Scenario, TrackScore, Vehicle, VehicleState, Waypoints};
-
-const PROFILE: &str = include_str!("../data/bathymetry/us_monterey_canyon_1.csv");
+use auvnav::{Scenario, TrackScore, VehicleState};
 
 #[inline(never)]
 fn plain_track(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> VehicleState<3> {
@@ -30,23 +30,8 @@ fn gradient_track(sc: &Scenario<'_, 3>, st: &VehicleState<3>) -> f32 {
 }
 
 fn main() {
-    let rows: Vec<(f32, f32)> = PROFILE
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let mut it = l.split(',');
-            (
-                it.next().unwrap().parse().unwrap(),
-                it.next().unwrap().parse().unwrap(),
-            )
-        })
-        .collect();
-    let x: Vec<f32> = rows.iter().map(|r| r.0).collect();
-    let b: Vec<f32> = rows.iter().map(|r| r.1).collect();
-    let v = Vehicle::c_auv4().unwrap();
-    let p = Profile::<256>::new(&x, &b).unwrap();
-    let w = Waypoints::<8>::new(&[0.0, 625.0, 1425.0, 2250.0, 2850.0, 3525.0]).unwrap();
-    let sc = Scenario::new(&v, &p, &w, Mission::default()).unwrap();
+    let l = common::line();
+    let sc = l.scenario();
     let st = sc.start_state(sc.default_initial_depth());
     let mut s = [TrackScore::default()];
     let st = sc.simulate(&st, 0, &[866.86], &mut s, |_| {}).unwrap();
