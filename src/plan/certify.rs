@@ -214,15 +214,37 @@ impl<const N: usize> Tube<N> {
         depths: &[f32],
         (floor, flights): (f32, &mut u32),
     ) -> Certificate {
+        let n = self.worlds.len();
+        let start = self.worst.get().min(n.saturating_sub(1));
+        let order = (start..n).chain(0..start);
+        let (c, worst) = self.fly_worlds(sc, bottom, depths, order, (floor, flights));
+        if let Some(i) = worst {
+            self.worst.set(i);
+        }
+        self.mark_worst();
+        c
+    }
+
+    /// Flies `depths` in the worlds `order` names (indices), each from its
+    /// state, into one certificate (less the margin), with the world that
+    /// set its least altitude; `partial` when it stopped with worlds left
+    /// because that altitude fell below `floor` (m).
+    fn fly_worlds(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        depths: &[f32],
+        order: impl Iterator<Item = usize>,
+        (floor, flights): (f32, &mut u32),
+    ) -> (Certificate, Option<usize>) {
         let mut c = Certificate {
             first: f32::INFINITY,
             all: f32::INFINITY,
             partial: false,
         };
-        let n = self.worlds.len();
-        let start = self.worst.get().min(n.saturating_sub(1));
-        let order = (start..n).chain(0..start);
-        for (k, i) in order.enumerate() {
+        let mut worst = None;
+        let mut order = order.peekable();
+        while let Some(i) = order.next() {
             let (Some(w), Some(st)) = (self.worlds.get(i), self.states.get(i)) else {
                 continue;
             };
@@ -231,15 +253,14 @@ impl<const N: usize> Tube<N> {
             c.first = c.first.min(first - self.margin);
             if all - self.margin < c.all {
                 c.all = all - self.margin;
-                self.worst.set(i);
+                worst = Some(i);
             }
-            if c.all < floor && k.saturating_add(1) < n {
+            if c.all < floor && order.peek().is_some() {
                 c.partial = true;
                 break;
             }
         }
-        self.mark_worst();
-        c
+        (c, worst)
     }
 
     /// Adds the worst world to the critical ones.
@@ -271,21 +292,10 @@ impl<const N: usize> Tube<N> {
         mask: Worlds,
         flights: &mut u32,
     ) -> Certificate {
-        let mut c = Certificate {
-            first: f32::INFINITY,
-            all: f32::INFINITY,
-            partial: false,
-        };
-        for (i, (w, st)) in self.worlds.iter().zip(self.states.iter()).enumerate() {
-            if !has(&mask, i) {
-                c.partial = true;
-                continue;
-            }
-            let at = (st, self.track);
-            let (first, all) = fly_world(sc, w, bottom, at, depths, (0.0, &mut []), flights);
-            c.first = c.first.min(first - self.margin);
-            c.all = c.all.min(all - self.margin);
-        }
+        let n = self.worlds.len();
+        let order = (0..n).filter(|&i| has(&mask, i));
+        let (mut c, _) = self.fly_worlds(sc, bottom, depths, order, (f32::NEG_INFINITY, flights));
+        c.partial = (0..n).any(|i| !has(&mask, i));
         c
     }
 }
