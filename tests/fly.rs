@@ -147,30 +147,31 @@ fn nominal_world_flies_the_planners_predictions() {
     let flown = g["first_flight_track_min_altitude"].as_array().unwrap();
     let predicted = g["first_flight_predicted_min_altitude"].as_array().unwrap();
     assert_eq!(flown.len(), 5);
-    for (t, (f, p)) in flown.iter().zip(predicted).enumerate() {
-        let (f, p) = (f.as_f64().unwrap(), p.as_f64().unwrap());
-        assert!(
-            (f - p).abs() < 2e-3,
-            "track {}: flown {f} m, predicted {p} m",
-            t + 1
-        );
-    }
+    let predicted: Vec<f64> = predicted.iter().map(|p| p.as_f64().unwrap()).collect();
+    within_2mm(flown, &predicted, "predicted");
     // And the same altitudes as the planning tool's own plan of the line.
     let out = Command::new(tool()).arg("--json").output().unwrap();
     let plan: Value = serde_json::from_slice(&out.stdout).unwrap();
-    for (t, (f, tr)) in flown
+    let planned: Vec<f64> = plan["tracks"]
+        .as_array()
+        .unwrap()
         .iter()
-        .zip(plan["tracks"].as_array().unwrap())
-        .enumerate()
-    {
-        let (f, m) = (f.as_f64().unwrap(), tr["min_altitude"].as_f64().unwrap());
+        .map(|tr| tr["min_altitude"].as_f64().unwrap())
+        .collect();
+    within_2mm(flown, &planned, "plan");
+    assert_eq!(g["below_min_altitude"], 0);
+}
+
+/// Each track's flown least altitude within 2e-3 m of `other`'s (m).
+fn within_2mm(flown: &[Value], other: &[f64], what: &str) {
+    for (t, (f, o)) in flown.iter().zip(other).enumerate() {
+        let f = f.as_f64().unwrap();
         assert!(
-            (f - m).abs() < 2e-3,
-            "track {}: flown {f} m, plan {m} m",
+            (f - o).abs() < 2e-3,
+            "track {}: flown {f} m, {what} {o} m",
             t + 1
         );
     }
-    assert_eq!(g["below_min_altitude"], 0);
 }
 
 #[test]
