@@ -2,7 +2,9 @@
 
 use std::path::Path;
 
-use auvnav::{AutopilotConfig, Mission, PidGains, TfKind, TransferFunction, VehicleConfig};
+use auvnav::{
+    AutopilotConfig, ConfigError, Mission, PidGains, TfKind, TransferFunction, VehicleConfig,
+};
 use serde::Deserialize;
 
 use crate::fail::Fail;
@@ -251,9 +253,8 @@ impl OptimizerSettings {
 }
 
 /// The declared uncertainty of model.md section 12 (every bound defaults
-/// to 0: the nominal model and map). The library does not take it yet:
-/// the tool parses and validates it here so that it can be wired into the
-/// planner's certification later.
+/// to 0: the nominal model and map), as the config file gives it; the
+/// library's own [`auvnav::Uncertainty`] from [`Uncertainty::declared`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Uncertainty {
     /// `e_h`, m: along-track offset between map and navigated position at `X_0`.
@@ -268,6 +269,20 @@ pub struct Uncertainty {
     pub flight_path_offset_deg: f32,
     /// `w_max`, m/s: bound on a constant vertical water velocity.
     pub vertical_current: f32,
+}
+
+impl Uncertainty {
+    /// The library's declared uncertainty (validated again there).
+    pub fn declared(&self) -> Result<auvnav::Uncertainty, ConfigError> {
+        auvnav::Uncertainty::new(
+            self.horizontal,
+            self.drift,
+            self.vertical,
+            self.speed,
+            self.flight_path_offset_deg,
+            self.vertical_current,
+        )
+    }
 }
 
 /// Everything the config file sets, resolved against the defaults.

@@ -20,8 +20,8 @@ mod source;
 use std::process::ExitCode;
 
 use auvnav::{
-    Method, Mode, PlanError, Planner, PlannerConfig, Profile, Scenario, TrackScore, Uncertainty,
-    Vehicle, Waypoints, lower_envelope,
+    Method, Mode, PlanError, Planner, PlannerConfig, Profile, Scenario, TrackScore, Vehicle,
+    Waypoints, lower_envelope,
 };
 
 use args::Args;
@@ -104,16 +104,8 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
     let vehicle = Vehicle::new(&cfg.vehicle, cfg.plant)
         .map_err(|e| Fail::input(format!("{}{e}", input::prefix(cfg_name))))?;
-    let u = &cfg.uncertainty;
-    let uncertainty = Uncertainty::new(
-        u.horizontal,
-        u.drift,
-        u.vertical,
-        u.speed,
-        u.flight_path_offset_deg,
-        u.vertical_current,
-    )
-    .map_err(|e| Fail::input(format!("{}{e}", input::prefix(cfg_name))))?;
+    let uncertainty = (cfg.uncertainty.declared())
+        .map_err(|e| Fail::input(format!("{}{e}", input::prefix(cfg_name))))?;
     let mission = cfg.mission.with_uncertainty(uncertainty);
     // The certification bottom: the map's lower envelope under the map
     // uncertainty (the map itself when none is declared).

@@ -175,16 +175,7 @@ pub fn main(args: impl Iterator<Item = String>) -> Result<(), Fail> {
     let waypoints =
         Waypoints::<WAYPOINTS>::new(&wx).map_err(|e| Fail::input(format!("{wp_name}: {e}")))?;
     let vehicle = Vehicle::new(&cfg.vehicle, cfg.plant).map_err(|e| Fail::input(format!("{e}")))?;
-    let u = &cfg.uncertainty;
-    let declared = Uncertainty::new(
-        u.horizontal,
-        u.drift,
-        u.vertical,
-        u.speed,
-        u.flight_path_offset_deg,
-        u.vertical_current,
-    )
-    .map_err(|e| Fail::input(format!("config: {e}")))?;
+    let declared = (cfg.uncertainty.declared()).map_err(|e| Fail::input(format!("config: {e}")))?;
     let x0 = wx[0];
     let envelope = Box::new(
         lower_envelope::<{ 3 * SAMPLES + 1 }>(profile.view(), &declared, x0)
