@@ -14,7 +14,9 @@
 pub mod armijo;
 pub mod bfgs;
 pub mod gd;
+pub(crate) mod qp;
 pub(crate) mod root;
+pub(crate) mod sqp;
 
 use core::fmt;
 

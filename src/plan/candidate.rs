@@ -15,12 +15,21 @@ use super::objective::PlanObjective;
 use super::planner::Warm;
 use super::scan::{ScanLog, ScanSpec, scan_start, search_box};
 use super::single::{self, Decision};
-use super::solve::Merge;
+use super::solve::{LATER_SHARE, Merge};
 use super::status::{Found, OptimizerStop};
 use super::{Method, Mode, PlanError, Planner};
 
 /// First step of a warm-started solve, relative to `first_step`.
 const WARM_FIRST_STEP: f32 = 0.1;
+
+/// The SQP's segments further above the target than `h_r − h_a` or this,
+/// whichever is more (m), stay out of its step.
+const SQP_BAND: f32 = 4.0;
+
+/// The tolerance of a boundary (m): 0.2 % of `h_r − h_a` (m), 1 mm to 2 cm.
+pub(super) fn boundary_tolerance(span: f32) -> f32 {
+    (0.002 * span).clamp(1e-3, 0.02)
+}
 
 /// What one call works with, fixed at its start.
 pub(super) struct Setup<const K: usize> {
@@ -90,6 +99,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         {
             return Ok(done);
         }
+        if self.cfg.method == Method::Bfgs && s.h >= 2 {
+            return self.sqp_candidate(sc, &s, (&mut fl, &mut scan), (penalized, &z0));
+        }
         let mu = if single { 0.0 } else { s.mu };
         let mut obj = PlanObjective::new(penalized, state, track, s.h, mu);
         obj.guard = single.then_some(s.h_safe);
@@ -120,7 +132,49 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         fl.count = fl.count.saturating_add(obj.evaluations);
         let spent = obj.evaluations >= obj.budget;
         let (f, found) = self.verify(&mut fl, &s, (obj.last_flight, spent), &mut scan)?;
-        self.keep_warm(track, s.h, f.depth, obj.mu);
+        self.keep_warm(track, s.h, f.depth, (obj.mu, 0));
+        self.horizon_len = s.h;
+        Ok(Candidate {
+            flown: f,
+            found,
+            iterations,
+            evaluations: fl.count,
+            h_safe: s.h_safe,
+            cert: None,
+        })
+    }
+
+    /// The candidate of a horizon under BFGS: the SQP from the start
+    /// point, on `Σ J` with every track's least altitude at or above the
+    /// certified altitude plus the boundary tolerance (module docs of
+    /// `solve`), then verified as any candidate.
+    fn sqp_candidate(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        s: &Setup<K>,
+        (fl, scan): (&mut Flights<'_, '_, N>, &mut ScanLog),
+        (penalized, z0): (Scenario<'_, N>, &[f32; K]),
+    ) -> Result<Candidate<N>, PlanError> {
+        let m = sc.mission();
+        let tol = boundary_tolerance(m.reference_altitude() - m.min_altitude());
+        let mut obj = PlanObjective::new(penalized, fl.state, fl.track, s.h, 0.0);
+        obj.budget = self.budget.optimizer(fl.count)?;
+        if self.cfg.constrained {
+            // The later tracks keep a share of the penalty margin: the next
+            // calls start from their depths, and from a measured state a
+            // plan on the boundary would not hold (`solve.rs`).
+            obj.target = (
+                s.h_safe + tol,
+                s.h_safe + tol + LATER_SHARE * self.cfg.penalty_margin,
+            );
+            obj.band = (m.reference_altitude() - m.min_altitude()).max(SQP_BAND);
+        }
+        let skip = s.warm.map_or(0, |w| w.plateaus);
+        let (iterations, plateaus) = self.solve_sqp(&mut obj, z0, (s.h, &s.bounds), tol, skip)?;
+        fl.count = fl.count.saturating_add(obj.evaluations);
+        let spent = obj.evaluations >= obj.budget;
+        let (f, found) = self.verify(fl, s, (None, spent), scan)?;
+        self.keep_warm(fl.track, s.h, f.depth, (0.0, plateaus));
         self.horizon_len = s.h;
         Ok(Candidate {
             flown: f,
@@ -324,7 +378,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// Keeps the rest of the horizon for the next call (horizon mode).
-    fn keep_warm(&mut self, track: usize, h: usize, depth: f32, mu: f32) {
+    fn keep_warm(&mut self, track: usize, h: usize, depth: f32, (mu, plateaus): (f32, u64)) {
         if let Some(first) = self.work.z.first_mut() {
             *first = depth;
         }
@@ -338,6 +392,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 depths,
                 len: h.saturating_sub(1),
                 mu,
+                plateaus: plateaus >> 1,
             }
         });
     }

@@ -5,7 +5,8 @@
 //! ```text
 //! state at X_{n-1}, waypoints, bottom ─► search box (reachable depths)
 //!   ─► start: coarse scan, a beam over the tracks (or the previous call's plan)
-//!   ─► BFGS or GD on  Φ(ζ) = Σ J + μ Σ V          ζ = (z_n .. z_{n+h-1})
+//!   ─► BFGS: SQP on Σ J, every segment's least altitude ≥ the target
+//!      (GD: Φ(ζ) = Σ J + μ Σ V)                  ζ = (z_n .. z_{n+h-1})
 //!   ─► verify z_n by simulation ─► safe? ─ no ─► closest safe depth, or the safest
 //!   ─► certify z_n with a continuation to the line's end in every declared world
 //!        (the horizon, then the climb; else a search from the last certified one)
@@ -53,14 +54,34 @@
 //! parabola vertex, and an unsafe optimum falls back to the boundary by
 //! the same search.
 //!
-//! **Constraint, a horizon.** `h >= h_a` enters the optimization as a
-//! quadratic penalty: `Φ = Σ J + μ Σ V` with `V = ½ ∫ max(0, h_a + m_p − h)² dx`
-//! (the violation of [`crate::TrackScore`], taken against `h_a` plus the
-//! penalty margin `m_p`), whose exact gradient comes from the same tangent
-//! pass. `J` ranges from 1e2 to 1e8 m³ between a shallow bay and a canyon
-//! wall, so no single `μ` fits: the sequential penalty method (N&W §17.1)
-//! re-solves from the last optimum with `μ` a hundred times larger while
-//! that optimum still violates, for at most `penalty_stages` stages.
+//! **Constraint, a horizon, under BFGS: SQP.** Each track is cut into
+//! segments of about 100 m (`sim/watch.rs`); each segment's least altitude,
+//! with its exact gradient from the same tangent pass, is one linearized
+//! constraint `h_seg + ∇h_seg·Δz >= target` of a quadratic program whose
+//! metric is BFGS's (first the Gauss–Newton matrix of `Σ J`, then Powell's
+//! damped update on the Lagrangian), and the step is accepted by Armijo
+//! backtracking on the ℓ1 merit `Σ J + ρ Σ_tracks max(0, target − h_min)`
+//! (`optim::sqp`, `optim::qp`). The target is the certified altitude
+//! `h_a + m_s` plus the boundary tolerance on the first track, and that plus
+//! a quarter of the penalty margin `m_p` on the later ones (the next calls
+//! start from their depths, and from a measured state a plan on the
+//! boundary would not hold). So the committed depth lands on the certified
+//! boundary where the constraint is active, in a handful of iterations
+//! (about 5 cold, 0–1 warm on the Monterey lines), from any start: the
+//! starting point only picks the basin. A coordinate whose gradient is
+//! exactly zero (a plateau, contract §10) is scanned once, the tracks
+//! before it flown once for all its points; a later call that continues
+//! the plan does not scan it again.
+//!
+//! **Constraint, a horizon, under GD** (the paper's baseline). `h >= h_a`
+//! enters the optimization as a quadratic penalty: `Φ = Σ J + μ Σ V` with
+//! `V = ½ ∫ max(0, h_a + m_p − h)² dx` (the violation of
+//! [`crate::TrackScore`], taken against `h_a` plus the penalty margin
+//! `m_p`), whose exact gradient comes from the same tangent pass. `J`
+//! ranges from 1e2 to 1e8 m³ between a shallow bay and a canyon wall, so
+//! no single `μ` fits: the sequential penalty method (N&W §17.1) re-solves
+//! from the last optimum with `μ` a hundred times larger while that
+//! optimum still violates, for at most `penalty_stages` stages.
 //!
 //! **Verification.** The candidate depth is **verified by simulation** on
 //! its track: below `h_a + m_s` (the safety margin, covering f32 vs f64
@@ -93,9 +114,9 @@
 //! | `commit.rs` | what is committed: the certified continuation (§11) |
 //! | `certify.rs` | certificates over the declared worlds (§12), [`certify_line`] |
 //! | `flights.rs` | the call's plain flights, counted |
-//! | `solve.rs` | the optimizer runs: penalty stages, plateau escape |
+//! | `solve.rs` | the optimizer runs: the SQP (BFGS), penalty stages (GD), plateau escape |
 //! | `scan.rs` | the search box and the coarse scan (the starting point) |
-//! | `objective.rs` | `Φ = Σ J + μ Σ V` for the optimizer |
+//! | `objective.rs` | the optimizers' objective: `Σ J` with the segments' constraints (SQP), `Φ = Σ J + μ Σ V` (GD) |
 //! | `single.rs` | the constrained single track's decision from its scan |
 //! | `fallback.rs` | the closest safe depth, the safe-set boundary |
 

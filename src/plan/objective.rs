@@ -1,8 +1,11 @@
-//! The objective the optimizer minimizes over a horizon,
-//! `Φ(ζ) = Σ J + μ Σ V`, with its exact gradient from the tangent pass.
+//! The objective the optimizer minimizes over a horizon: for the SQP
+//! (BFGS), `Σ J` under each segment's least altitude at or above the
+//! target altitude; for GD and a single track, `Φ(ζ) = Σ J + μ Σ V`. Both
+//! with their exact gradients from the tangent pass.
 
 use crate::optim::Objective;
-use crate::sim::{Scenario, SimError, TrackScore, VehicleState};
+use crate::optim::sqp::{Constrained, Constraint, Linearized};
+use crate::sim::{Scenario, SimError, TrackScore, VehicleState, Watch};
 
 /// Why [`PlanObjective`] did not return a value: the flight failed, the
 /// budget is spent, or (a constrained single track) the optimizer has left
@@ -47,6 +50,13 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     /// The safe depth of least `J` evaluated, with `J` and its minimum
     /// altitude (m, m³, m).
     pub best_safe: Option<(f32, f32, f32)>,
+    /// The SQP's target altitudes (m): the first track's least altitude at
+    /// or above `target.0`, every later one's at or above `target.1`, is
+    /// feasible.
+    pub target: (f32, f32),
+    /// Segments further above the target than this (m) stay out of the
+    /// SQP's step.
+    pub band: f32,
 }
 
 impl<'a, const N: usize> PlanObjective<'a, N> {
@@ -72,6 +82,8 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             guard: None,
             tripped: None,
             best_safe: None,
+            target: (f32::NEG_INFINITY, f32::NEG_INFINITY),
+            band: f32::INFINITY,
         }
     }
 }
@@ -81,13 +93,7 @@ impl<const N: usize> PlanObjective<'_, N> {
     /// entries past `count` default). Counts as an evaluation, within the
     /// budget; leaves the last point's records (`last_*`) alone.
     pub fn flight<const K: usize>(&mut self, z: &[f32; K]) -> Result<[TrackScore; K], Stop> {
-        if self.tripped.is_some() {
-            return Err(Stop::LeftSafeSet);
-        }
-        if self.evaluations >= self.budget {
-            return Err(Stop::Budget);
-        }
-        self.evaluations = self.evaluations.saturating_add(1);
+        self.count_flight()?;
         let used = z.get(..self.count).ok_or(Stop::Sim(SimError::TrackRange))?;
         let mut scores = [TrackScore::default(); K];
         let sc = scores
@@ -97,6 +103,89 @@ impl<const N: usize> PlanObjective<'_, N> {
             .fly(self.start, self.track, used, sc)
             .map_err(Stop::Sim)?;
         Ok(scores)
+    }
+
+    /// The SQP's target altitude of track `t` of the horizon, m.
+    fn target_of(&self, t: usize) -> f32 {
+        if t == 0 { self.target.0 } else { self.target.1 }
+    }
+
+    /// The ℓ1 infeasibility of `scores` for the SQP: the sum over the
+    /// tracks of their least altitude's shortfall below their target, m.
+    fn infeasibility(&self, scores: &[TrackScore]) -> f32 {
+        scores
+            .iter()
+            .take(self.count)
+            .enumerate()
+            .map(|(t, s)| (self.target_of(t) - s.min_altitude()).max(0.0))
+            .sum()
+    }
+
+    /// Counts one flight within the budget.
+    fn count_flight(&mut self) -> Result<(), Stop> {
+        if self.tripped.is_some() {
+            return Err(Stop::LeftSafeSet);
+        }
+        if self.evaluations >= self.budget {
+            return Err(Stop::Budget);
+        }
+        self.evaluations = self.evaluations.saturating_add(1);
+        Ok(())
+    }
+
+    /// The scores of tracks `0..j` of the horizon `z` and the state they
+    /// end in (the start's for `j = 0`): one flight, counted as
+    /// [`Self::flight`], none for `j = 0`.
+    pub fn head<const K: usize>(
+        &mut self,
+        z: &[f32; K],
+        j: usize,
+    ) -> Result<([TrackScore; K], VehicleState<N>), Stop> {
+        let mut scores = [TrackScore::default(); K];
+        if j == 0 {
+            return Ok((scores, *self.start));
+        }
+        self.count_flight()?;
+        let used = z
+            .get(..j.min(self.count))
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        let sc = scores
+            .get_mut(..used.len())
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        let end = self
+            .sc
+            .fly(self.start, self.track, used, sc)
+            .map_err(Stop::Sim)?;
+        Ok((scores, end))
+    }
+
+    /// `(Σ J, v)` of the horizon `z` whose tracks before `j` flew `head`
+    /// and left `at_j` (see [`Self::head`]): the tracks from `j` flown, one
+    /// flight, counted.
+    pub fn tail_value<const K: usize>(
+        &mut self,
+        head: &[TrackScore; K],
+        (at_j, j): (&VehicleState<N>, usize),
+        z: &[f32; K],
+    ) -> Result<(f32, f32), Stop> {
+        self.count_flight()?;
+        let used = z
+            .get(j..self.count)
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        let mut scores = *head;
+        let tail = scores
+            .get_mut(j..self.count)
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        self.sc
+            .fly(at_j, self.track.saturating_add(j), used, tail)
+            .map_err(Stop::Sim)?;
+        let sc = scores.get(..self.count).unwrap_or(&[]);
+        let total: f32 = sc.iter().map(TrackScore::j).sum();
+        if total.is_finite() {
+            Ok((total, self.infeasibility(sc)))
+        } else {
+            Err(Stop::Sim(SimError::Diverged))
+        }
     }
 
     /// `Φ(ζ)` alone, by a plain flight of the horizon (no tangents): what
@@ -119,13 +208,7 @@ impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
     type Error = Stop;
 
     fn eval(&mut self, z: &[f32; K]) -> Result<(f32, [f32; K]), Stop> {
-        if self.tripped.is_some() {
-            return Err(Stop::LeftSafeSet);
-        }
-        if self.evaluations >= self.budget {
-            return Err(Stop::Budget);
-        }
-        self.evaluations = self.evaluations.saturating_add(1);
+        self.count_flight()?;
         let e = self
             .sc
             .evaluate_tracks(self.start, self.track, z, self.count)
@@ -157,5 +240,58 @@ impl<const N: usize, const K: usize> Objective<K> for PlanObjective<'_, N> {
     /// value there).
     fn value(&mut self, z: &[f32; K]) -> Option<Result<f32, Stop>> {
         (self.count > 1 && self.guard.is_none()).then(|| self.flight_value(z))
+    }
+}
+
+impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
+    type Error = Stop;
+
+    /// `Σ J`, its gradient, and one constraint per segment of the horizon
+    /// (`watch.rs`): its least altitude above the target, with its
+    /// gradient, grouped by track.
+    fn linearize(&mut self, z: &[f32; K], gn: bool, out: &mut Linearized<K>) -> Result<(), Stop> {
+        self.count_flight()?;
+        let wp = self.sc.waypoints().positions();
+        let h_r = self.sc.mission().reference_altitude();
+        let mut watch = Watch::<K>::new(wp, self.track, self.count, h_r, gn);
+        let e = self
+            .sc
+            .evaluate_watched(self.start, self.track, z, self.count, &mut watch)
+            .map_err(Stop::Sim)?;
+        out.j = e.j;
+        out.grad = e.grad_j;
+        out.infeasibility = self.infeasibility(&e.scores);
+        out.band = self.band;
+        out.rows.clear();
+        for s in 0..watch.segments {
+            let (Some(&m), Some(g), Some(&t)) =
+                (watch.min.get(s), watch.grad.get(s), watch.track.get(s))
+            else {
+                continue;
+            };
+            let _ = out.rows.push(Constraint {
+                c: m - self.target_of(usize::from(t)),
+                a: *g,
+                group: t,
+            });
+        }
+        if let Some(m) = watch.gn {
+            out.gn = m;
+        }
+        self.last_violation = out.infeasibility;
+        self.last_min_altitude = e.min_altitude;
+        self.last_flight = None;
+        Ok(())
+    }
+
+    fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Stop> {
+        let scores = self.flight(z)?;
+        let sc = scores.get(..self.count).unwrap_or(&[]);
+        let j: f32 = sc.iter().map(TrackScore::j).sum();
+        if j.is_finite() {
+            Ok((j, self.infeasibility(sc)))
+        } else {
+            Err(Stop::Sim(SimError::Diverged))
+        }
     }
 }

@@ -62,6 +62,9 @@ pub(super) struct Warm<const K: usize> {
     pub len: usize,
     /// The penalty weight the previous call ended with.
     pub mu: f32,
+    /// Horizon positions (bit `j`: `track + j`) whose plateau the previous
+    /// call's SQP scanned already (`solve.rs`).
+    pub plateaus: u64,
 }
 
 /// Reference depths for the tracks `track..track + len`, m.

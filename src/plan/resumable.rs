@@ -113,6 +113,7 @@ impl<const K: usize, const N: usize> Resumable<K, N> {
                 depths: b.work.z,
                 len: b.horizon_len,
                 mu: b.warm.map_or(b.cfg.penalty_weight, |w| w.mu),
+                plateaus: 0,
             });
         }
         let plan = attempt.plan(sc, &state, track)?;

@@ -1,9 +1,12 @@
-//! The penalized solve of a horizon: one optimizer run merged onto the
+//! The optimizer runs of a horizon. Under BFGS: the SQP on the segments'
+//! minimum-altitude constraints (`optim::sqp`) and its plateau escape.
+//! Under GD (the paper's baseline): one optimizer run merged onto the
 //! planner's workspace, the sequential penalty stages (N&W §17.1: `μ`
 //! ×100 while the optimum still violates), the plateau escape, and the
 //! committed track moved onto the certified boundary.
 
 use crate::optim::root::{self, RootTol};
+use crate::optim::sqp::sqp_into;
 use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
 use crate::sim::{SimError, TrackScore};
 
@@ -29,7 +32,7 @@ const BOUNDARY_DEPTH: f32 = 1e-3;
 /// last, single-track call can lose the safe depths of its track (Medes 1:
 /// `J` +40 %); with all of it, the committed depth cannot move wherever the
 /// later tracks are held too.
-const LATER_SHARE: f32 = 0.25;
+pub(super) const LATER_SHARE: f32 = 0.25;
 
 /// `(Σ J, least altitude of the first track, least altitude of the later
 /// ones)` of the horizon `z` by a plain flight (m³, m, m; `+∞` with no
@@ -62,7 +65,118 @@ pub(super) enum Merge {
     IfBetter,
 }
 
+/// The planner's error for an optimizer that could not start.
+fn start_error(e: OptimError<Stop>) -> PlanError {
+    match e {
+        OptimError::Config(p) => PlanError::Config(p.into()),
+        OptimError::Start(Stop::Sim(e)) => PlanError::Sim(e),
+        OptimError::Start(Stop::LeftSafeSet | Stop::Budget) | OptimError::NonFinite => {
+            PlanError::Sim(SimError::Diverged)
+        }
+    }
+}
+
 impl<const K: usize, const N: usize> Planner<K, N> {
+    /// The SQP of a horizon (BFGS), from `z0`, onto the workspace; then
+    /// the plateau escape: a coordinate whose gradient is exactly zero is
+    /// scanned over its box, the others held, and the SQP restarted from
+    /// a feasible point of lower `J` (kept if it ends lower). A coordinate
+    /// in `skip` (bit `j`) was scanned by the previous call, whose plan
+    /// this one continues, and is not scanned again. `tol` is the
+    /// feasibility tolerance (m). Returns the iterations and the
+    /// coordinates scanned (bits).
+    pub(super) fn solve_sqp(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        z0: &[f32; K],
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        skip: u64,
+    ) -> Result<(u32, u64), PlanError> {
+        self.work.history.clear();
+        let run = sqp_into(obj, z0, (bounds, h), &self.cfg.bfgs, tol, &mut self.work);
+        let unstarted = matches!(run, Err(OptimError::Start(Stop::Budget)));
+        if unstarted {
+            self.work = crate::optim::Outcome::at(z0);
+            return Ok((0, 0));
+        }
+        run.map_err(start_error)?;
+        let mut iterations = self.work.iterations;
+        let mut scanned = 0_u64;
+        let cap = self.cfg.bfgs.max_iterations;
+        for j in 0..h {
+            let bit = u32::try_from(j)
+                .ok()
+                .and_then(|j| 1_u64.checked_shl(j))
+                .unwrap_or(0);
+            if iterations >= cap || skip & bit != 0 {
+                continue;
+            }
+            if self.work.gradient.get(j).is_some_and(|&g| g == 0.0) {
+                scanned |= bit;
+            }
+            let Some(z) = self.sqp_plateau_jump(obj, bounds, j, tol) else {
+                continue;
+            };
+            let acc = &self.work;
+            let kept = (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status);
+            let kept_counts = (acc.iterations, acc.evaluations, acc.history.len());
+            let left = BfgsConfig {
+                max_iterations: cap.saturating_sub(iterations).saturating_sub(1).max(1),
+                ..self.cfg.bfgs
+            };
+            let restart = sqp_into(obj, &z, (bounds, h), &left, tol, &mut self.work);
+            let acc = &mut self.work;
+            let better = restart.is_ok()
+                && obj.last_violation <= tol
+                && acc.j.partial_cmp(&kept.1) == Some(core::cmp::Ordering::Less);
+            if better {
+                iterations = iterations.saturating_add(acc.iterations).saturating_add(1);
+            } else {
+                (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
+                (acc.iterations, acc.evaluations) = (kept_counts.0, kept_counts.1);
+                acc.history.truncate(kept_counts.2);
+            }
+        }
+        self.work.iterations = iterations;
+        Ok((iterations, scanned | skip))
+    }
+
+    /// The best feasible point of a scan of coordinate `j` over its box
+    /// when `∂J/∂z_j` is exactly zero (the pitch reference saturated over
+    /// the whole track), if its `J` beats the optimum's by more than the
+    /// stopping threshold.
+    fn sqp_plateau_jump(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        bounds: &Bounds<K>,
+        j: usize,
+        tol: f32,
+    ) -> Option<[f32; K]> {
+        let (&lo, &hi) = bounds.lo.get(j).zip(bounds.hi.get(j))?;
+        let out = &self.work;
+        if lo >= hi || out.gradient.get(j).is_none_or(|&g| g != 0.0) {
+            return None;
+        }
+        let threshold = out.j - self.cfg.bfgs.tol.j_threshold(out.j);
+        // The tracks before `j` fly the same whatever `z_j`: once.
+        let (head, at_j) = obj.head(&out.z, j).ok()?;
+        let mut best: Option<(f32, [f32; K])> = None;
+        for k in 0..self.cfg.scan_points {
+            let mut z = out.z;
+            if let Some(zj) = z.get_mut(j) {
+                *zj = grid(lo, hi, k, self.cfg.scan_points);
+            }
+            if let Ok((jz, v)) = obj.tail_value(&head, (&at_j, j), &z)
+                && v <= tol
+                && jz < best.as_ref().map_or(threshold, |b| b.0)
+            {
+                best = Some((jz, z));
+            }
+        }
+        best.map(|b| b.1)
+    }
+
     /// Further penalty stages: each re-solves from the last optimum with
     /// `μ` a hundred times larger while that optimum still violates, at most
     /// `penalty_stages` in all (one for a single track, whose boundary
@@ -304,13 +418,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // A run the budget does not allow to start is not a run.
         let unstarted = matches!(run, Err(OptimError::Start(Stop::Budget)));
         if !unstarted {
-            run.map_err(|e| match e {
-                OptimError::Config(p) => PlanError::Config(p.into()),
-                OptimError::Start(Stop::Sim(e)) => PlanError::Sim(e),
-                OptimError::Start(Stop::LeftSafeSet | Stop::Budget) | OptimError::NonFinite => {
-                    PlanError::Sim(SimError::Diverged)
-                }
-            })?;
+            run.map_err(start_error)?;
         }
         // (A NaN objective is not better either.)
         let worse = acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less);

@@ -172,6 +172,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             depths,
             len: h,
             mu,
+            plateaus: 0,
         });
     }
 
@@ -285,6 +286,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 depths: w,
                 len: warm_len,
                 mu: self.cfg.penalty_weight,
+                plateaus: 0,
             }
         });
     }

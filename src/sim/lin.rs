@@ -27,11 +27,12 @@ pub(crate) enum EndAt {
     Clip { t: f32 },
 }
 
-/// One end of a scored piece: where, and its `e = d_t − d` and
-/// `p = max(0, h_a − h)` (m).
+/// One end of a scored piece: where (and its along-track position `x`),
+/// and its `e = d_t − d` and `p = max(0, h_a − h)` (m).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct End {
     pub at: EndAt,
+    pub x: f32,
     pub e: f32,
     pub p: f32,
 }

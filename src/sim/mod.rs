@@ -10,6 +10,7 @@
 //! | `score.rs` | [`TrackScore`] and the one scoring kernel |
 //! | `lin.rs` | what a step and a scored piece linearize to |
 //! | `tangent.rs` | tangent states: [`Evaluation`], `∂J/∂z` by forward sensitivity |
+//! | `watch.rs` | what a tangent pass records for the SQP: segments' least altitudes, Gauss–Newton |
 //! | `estimate.rs` | [`Measurement`]; the start state from what the vehicle measures |
 //! | `world.rs` | [`World`]: true speed, flight-path offset, vertical current |
 //! | `error.rs` | [`SimError`] |
@@ -21,6 +22,7 @@ mod run;
 mod score;
 mod state;
 mod tangent;
+mod watch;
 mod world;
 
 pub use error::SimError;
@@ -28,6 +30,7 @@ pub use estimate::Measurement;
 pub use score::TrackScore;
 pub use state::{Sample, VehicleState};
 pub use tangent::Evaluation;
+pub(crate) use watch::Watch;
 pub use world::{MAX_WORLDS, World};
 
 use world::Kinematics;

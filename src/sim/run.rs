@@ -360,7 +360,8 @@ impl<const N: usize> Scenario<'_, N> {
                     max(acc.min_altitude, h_p)
                 };
             }
-            sens.piece(slot, &piece_within(dx, dd, &a0, &a1));
+            let ends = ((&a0, st.x_prev.value()), (&a1, st.x.value()));
+            sens.piece(slot, &piece_within(dx, dd, ends.0, ends.1));
             e2 = e2_next;
             a0 = a1;
         }

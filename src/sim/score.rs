@@ -150,20 +150,28 @@ pub(super) fn trapezoid(len: f32, a2: f32, b2: f32) -> f32 {
     len * (a2 + b2)
 }
 
-/// A piece of a segment inside one track, between two scored samples.
+/// A piece of a segment inside one track, between two scored samples at
+/// `x0` and `x1` (m).
 #[inline(always)]
-pub(super) fn piece_within(dx: f32, dd: f32, a0: &At, a1: &At) -> PieceLin {
+pub(super) fn piece_within(
+    dx: f32,
+    dd: f32,
+    (a0, x0): (&At, f32),
+    (a1, x1): (&At, f32),
+) -> PieceLin {
     PieceLin {
         len: dx,
         dx,
         dd,
         lo: End {
             at: EndAt::Start { slope: a0.slope },
+            x: x0,
             e: a0.e,
             p: a0.p,
         },
         hi: End {
             at: EndAt::End { slope: a1.slope },
+            x: x1,
             e: a1.e,
             p: a1.p,
         },
@@ -285,7 +293,15 @@ impl<const N: usize> Scenario<'_, N> {
         } else {
             EndAt::End { slope: a.slope }
         };
-        Ok((End { at, e: a.e, p: a.p }, a.h))
+        Ok((
+            End {
+                at,
+                x: s.x.value(),
+                e: a.e,
+                p: a.p,
+            },
+            a.h,
+        ))
     }
 
     /// A piece end clipped at waypoint `i`, depth interpolated in `x`.
@@ -303,12 +319,12 @@ impl<const N: usize> Scenario<'_, N> {
             .map_err(|_| SimError::OutOfProfile)?;
         let t = -s0.x.minus(c) / dx;
         let h = -s0.d.minus(b) - dd * t;
-        Ok((self.end(EndAt::Clip { t }, h), h))
+        Ok((self.end(EndAt::Clip { t }, c, h), h))
     }
 
     #[inline(always)]
-    fn end(&self, at: EndAt, h: f32) -> End {
+    fn end(&self, at: EndAt, x: f32, h: f32) -> End {
         let (e, p) = terms(h, self.mission.reference_altitude(), self.penalty_altitude);
-        End { at, e, p }
+        End { at, x, e, p }
     }
 }

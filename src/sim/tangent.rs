@@ -36,6 +36,7 @@ use crate::model::Vehicle;
 use crate::num::DEG;
 
 use super::lin::{EndAt, PieceLin, Sensitivity, StepLin};
+use super::watch::{NoWatch, Watch, Watcher};
 use super::{Scenario, SimError, TrackScore, VehicleState};
 
 /// The tangent of the state with respect to one reference depth, and the
@@ -82,14 +83,17 @@ impl<const N: usize> Column<N> {
 /// per depth. Depth `j`'s column is exactly zero until its track begins
 /// (the start state and the earlier tracks do not depend on it), so each
 /// step and piece updates only the columns of the tracks begun so far.
-struct Tangents<const N: usize, const K: usize> {
+/// The watcher `W` sees every piece with the columns' `∂e` (`watch.rs`).
+struct Tangents<'w, const N: usize, const K: usize, W: Watcher<K>> {
     cols: [Column<N>; K],
+    watch: &'w mut W,
 }
 
-impl<const N: usize, const K: usize> Tangents<N, K> {
+impl<'w, const N: usize, const K: usize, W: Watcher<K>> Tangents<'w, N, K, W> {
     /// The start state does not depend on `ζ`: every tangent is zero.
-    fn zero() -> Self {
+    fn zero(watch: &'w mut W) -> Self {
         Self {
+            watch,
             cols: [Column {
                 eta: SVector::zeros(),
                 d: 0.0,
@@ -105,7 +109,7 @@ impl<const N: usize, const K: usize> Tangents<N, K> {
     }
 }
 
-impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
+impl<const N: usize, const K: usize, W: Watcher<K>> Sensitivity<N> for Tangents<'_, N, K, W> {
     #[inline(always)]
     fn step(&mut self, v: &Vehicle<N>, lin: &StepLin) {
         let plant = v.plant();
@@ -154,15 +158,27 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<N, K> {
         let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
         let sq_p = 0.25 * (p.lo.p * p.lo.p + p.hi.p * p.hi.p);
         let half = 0.5 * p.len;
-        for col in self.cols.iter_mut().take(slot.saturating_add(1)) {
+        let mut de = [(0.0, 0.0); K];
+        for (col, de) in self
+            .cols
+            .iter_mut()
+            .zip(de.iter_mut())
+            .take(slot.saturating_add(1))
+        {
             let de_lo = col.de(p.lo.at, ratio);
             let de_hi = col.de(p.hi.at, ratio);
+            if W::ACTIVE {
+                *de = (de_lo, de_hi);
+            }
             let dlen = col.dx(p.hi.at) - col.dx(p.lo.at);
             col.grad_j += dlen * sq_e + (de_lo * p.lo.e + de_hi * p.hi.e) * half;
             // p = max(0, h_a − h) and e = h − h_r, so ∂p = −∂e where p > 0.
             let dp_lo = if p.lo.p > 0.0 { -de_lo } else { 0.0 };
             let dp_hi = if p.hi.p > 0.0 { -de_hi } else { 0.0 };
             col.grad_violation += dlen * sq_p + (dp_lo * p.lo.p + dp_hi * p.hi.p) * half;
+        }
+        if W::ACTIVE {
+            self.watch.piece(slot, p, &de);
         }
     }
 }
@@ -219,9 +235,39 @@ impl<const N: usize> Scenario<'_, N> {
         depths: &[f32; K],
         count: usize,
     ) -> Result<Evaluation<N, K>, SimError> {
+        self.evaluate_with(start, first_track, depths, count, &mut NoWatch)
+    }
+
+    /// As [`Scenario::evaluate_tracks`], recording the segments' least
+    /// altitudes with their gradients (and the Gauss–Newton matrix if
+    /// `watch` asks for it) into `watch`, laid out for this run by
+    /// [`Watch::new`].
+    ///
+    /// # Errors
+    /// As [`Scenario::evaluate_tracks`].
+    pub(crate) fn evaluate_watched<const K: usize>(
+        &self,
+        start: &VehicleState<N>,
+        first_track: usize,
+        depths: &[f32; K],
+        count: usize,
+        watch: &mut Watch<K>,
+    ) -> Result<Evaluation<N, K>, SimError> {
+        self.evaluate_with(start, first_track, depths, count, watch)
+    }
+
+    /// The one tangent pass, with its watcher.
+    fn evaluate_with<const K: usize, W: Watcher<K>>(
+        &self,
+        start: &VehicleState<N>,
+        first_track: usize,
+        depths: &[f32; K],
+        count: usize,
+        watch: &mut W,
+    ) -> Result<Evaluation<N, K>, SimError> {
         let used = depths.get(..count).ok_or(SimError::TrackRange)?;
         let mut scores = [TrackScore::default(); K];
-        let mut tan = Tangents::<N, K>::zero();
+        let mut tan = Tangents::<N, K, W>::zero(watch);
         let end =
             self.run::<_, _, true>(start, first_track, used, &mut scores, &mut tan, |_| {})?;
         let grad_j: [f32; K] = core::array::from_fn(|j| tan.cols.get(j).map_or(0.0, |c| c.grad_j));

@@ -1,0 +1,558 @@
+//! A small dense convex quadratic program, the step of the SQP
+//! ([`super::sqp`]):
+//!
+//! ```text
+//! min ½ dᵀ G d + gᵀ d   subject to   aᵢᵀ d + cᵢ >= 0,   i = 1..m
+//! ```
+//!
+//! over the first `n` of `K` variables (the rest are held at zero), with
+//! `G` symmetric positive definite. Solved by the dual active-set method
+//! of Goldfarb and Idnani (Math. Prog. 27, 1983), as R's `quadprog`:
+//! from the unconstrained minimum, the most violated constraint enters the
+//! active set, a full step satisfies it or a partial step drops an active
+//! constraint whose multiplier would turn negative; `J = L⁻ᵀ Q` and the
+//! triangular `R` are kept up to date by Givens rotations. It ends in at
+//! most `m + n` additions in exact arithmetic; here it is capped at
+//! `ITERATIONS`, and linearly dependent or incompatible constraints are
+//! reported, never looped on.
+//!
+//! Each row is scaled to a unit gradient first, so that the tolerances
+//! are in the unit of `d` (m for the planner).
+
+use heapless::Vec;
+use nalgebra::{SMatrix, SVector};
+
+/// Most constraint rows of one problem.
+pub(crate) const QP_ROWS: usize = 64;
+
+/// Most steps (additions and drops) of one solve.
+const ITERATIONS: usize = 4 * QP_ROWS;
+
+/// A row is violated when `aᵀd + c < -VIOLATION` (after scaling to a unit
+/// gradient: metres of `d`), relative to the problem's scale.
+const VIOLATION: f32 = 1e-5;
+
+/// A row whose gradient is shorter than this is ignored.
+const TINY: f32 = 1e-12;
+
+/// One linear inequality `aᵀ d + c >= 0` (unit of `c`: that of `aᵀ d`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Row<const K: usize> {
+    pub a: [f32; K],
+    pub c: f32,
+}
+
+/// Why the QP has no solution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum QpError {
+    /// `G` is not positive definite (or not finite).
+    NotDefinite,
+    /// The constraints have no common point.
+    Incompatible,
+    /// The iteration cap came first.
+    Iterations,
+}
+
+/// The solution: the step `d` and one multiplier per row (`λᵢ >= 0`,
+/// zero for inactive rows), in the rows' own unit.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct QpSolution<const K: usize> {
+    pub d: SVector<f32, K>,
+    pub lambda: Vec<f32, QP_ROWS>,
+}
+
+/// The working state of the dual method.
+struct Work<const K: usize> {
+    /// Variables used.
+    n: usize,
+    /// `J = L⁻ᵀ Q`: columns `0..q` span the active gradients.
+    j: SMatrix<f32, K, K>,
+    /// Upper triangular `R` (`q × q` in the top left).
+    r: SMatrix<f32, K, K>,
+    /// Active rows and their multipliers.
+    active: Vec<usize, K>,
+    u: Vec<f32, K>,
+    x: SVector<f32, K>,
+}
+
+fn at<const K: usize>(m: &SMatrix<f32, K, K>, i: usize, j: usize) -> f32 {
+    m.get((i, j)).copied().unwrap_or(0.0)
+}
+
+fn put<const K: usize>(m: &mut SMatrix<f32, K, K>, i: usize, j: usize, v: f32) {
+    if let Some(e) = m.get_mut((i, j)) {
+        *e = v;
+    }
+}
+
+fn vat<const K: usize>(v: &SVector<f32, K>, i: usize) -> f32 {
+    v.get(i).copied().unwrap_or(0.0)
+}
+
+/// `aᵀb` over the first `n` entries, in index order.
+fn dot_n<const K: usize>(a: &SVector<f32, K>, b: &SVector<f32, K>, n: usize) -> f32 {
+    a.iter()
+        .zip(b.iter())
+        .take(n)
+        .fold(0.0, |s, (x, y)| s + x * y)
+}
+
+/// The Givens reflection `(c, s)` taking `(a, b)` to `(h, 0)`, `h >= 0`.
+fn givens(a: f32, b: f32) -> (f32, f32, f32) {
+    let h = libm::hypotf(a, b);
+    if h > 0.0 {
+        (a / h, b / h, h)
+    } else {
+        (1.0, 0.0, 0.0)
+    }
+}
+
+/// Columns `p`, `p + 1` of `m` reflected by `(c, s)`: `(c x + s y, s x − c y)`.
+fn reflect_columns<const K: usize>(m: &mut SMatrix<f32, K, K>, p: usize, (c, s): (f32, f32)) {
+    let q = p.saturating_add(1);
+    for k in 0..K {
+        let (x, y) = (at(m, k, p), at(m, k, q));
+        put(m, k, p, c * x + s * y);
+        put(m, k, q, s * x - c * y);
+    }
+}
+
+/// Solves the problem of the module docs. `g_mat` and `g` beyond `n` are
+/// ignored, as are the rows' entries beyond `n`.
+///
+/// # Errors
+/// [`QpError`]: `G` not definite, rows incompatible, or the cap reached.
+pub(crate) fn solve<const K: usize>(
+    g_mat: &SMatrix<f32, K, K>,
+    g: &SVector<f32, K>,
+    n: usize,
+    rows: &[Row<K>],
+) -> Result<QpSolution<K>, QpError> {
+    let n = n.min(K);
+    let rows = rows.get(..rows.len().min(QP_ROWS)).unwrap_or(&[]);
+    // Rows scaled to unit gradients (zero rows kept as zero: ignored).
+    let mut scale: Vec<f32, QP_ROWS> = Vec::new();
+    let mut norms: Vec<SVector<f32, K>, QP_ROWS> = Vec::new();
+    let mut cs: Vec<f32, QP_ROWS> = Vec::new();
+    for row in rows {
+        let a = SVector::<f32, K>::from_fn(|i, _| {
+            if i < n {
+                row.a.get(i).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            }
+        });
+        let len = libm::sqrtf(dot_n(&a, &a, n));
+        let s = if len > TINY && len.is_finite() {
+            1.0 / len
+        } else {
+            0.0
+        };
+        let _ = scale.push(s);
+        let _ = norms.push(a * s);
+        let _ = cs.push(row.c * s);
+    }
+    let mut w = Work::start(g_mat, g, n)?;
+    let mut added = [false; QP_ROWS];
+    for _ in 0..ITERATIONS {
+        // The most violated row not active.
+        let mut worst: Option<(usize, f32)> = None;
+        for (i, (a, &c)) in norms.iter().zip(cs.iter()).enumerate() {
+            if scale.get(i).is_none_or(|&s| s == 0.0) || added.get(i).copied().unwrap_or(true) {
+                continue;
+            }
+            let s = dot_n(a, &w.x, n) + c;
+            if s < -VIOLATION && worst.is_none_or(|(_, v)| s < v) {
+                worst = Some((i, s));
+            }
+        }
+        let Some((p, _)) = worst else {
+            return Ok(w.solution(rows.len(), &scale));
+        };
+        let np = norms.get(p).copied().unwrap_or_else(SVector::zeros);
+        let cp = cs.get(p).copied().unwrap_or(0.0);
+        w.add(&np, cp, p)?;
+        // (Rows dropped on the way may enter again.)
+        for (i, flag) in added.iter_mut().enumerate() {
+            *flag = w.active.contains(&i);
+        }
+    }
+    Err(QpError::Iterations)
+}
+
+impl<const K: usize> Work<K> {
+    /// The unconstrained minimum `x = −G⁻¹ g`, `J = L⁻ᵀ`, nothing active.
+    fn start(g_mat: &SMatrix<f32, K, K>, g: &SVector<f32, K>, n: usize) -> Result<Self, QpError> {
+        // Only the used block; the rest is the identity (held at zero).
+        let m = SMatrix::<f32, K, K>::from_fn(|i, j| match (i < n, j < n) {
+            (true, true) => at(g_mat, i, j),
+            _ if i == j => 1.0,
+            _ => 0.0,
+        });
+        if !m.iter().all(|v| v.is_finite()) {
+            return Err(QpError::NotDefinite);
+        }
+        let chol = m.cholesky().ok_or(QpError::NotDefinite)?;
+        let l = chol.l();
+        let l_inv = l
+            .solve_lower_triangular(&SMatrix::identity())
+            .ok_or(QpError::NotDefinite)?;
+        let gn = SVector::<f32, K>::from_fn(|i, _| if i < n { vat(g, i) } else { 0.0 });
+        let x = -chol.solve(&gn);
+        if !x.iter().all(|v| v.is_finite()) {
+            return Err(QpError::NotDefinite);
+        }
+        Ok(Self {
+            n,
+            j: l_inv.transpose(),
+            r: SMatrix::zeros(),
+            active: Vec::new(),
+            u: Vec::new(),
+            x,
+        })
+    }
+
+    /// Adds row `p` (`npᵀ x + cp >= 0`, currently violated): partial steps
+    /// drop active rows until a full step satisfies it and it enters.
+    fn add(&mut self, np: &SVector<f32, K>, cp: f32, p: usize) -> Result<(), QpError> {
+        let mut u_new: f32 = 0.0;
+        for _ in 0..=K {
+            let q = self.active.len();
+            let d = self.j.transpose() * np;
+            // Primal direction in the null space of the active rows.
+            let mut z = SVector::<f32, K>::zeros();
+            for k in q..self.n {
+                z += self.j.column(k) * vat(&d, k);
+            }
+            // Dual direction: R r = d₁.
+            let r = self.back_substitute(&d, q);
+            // Partial step: the first active multiplier to reach zero.
+            let mut t1: Option<(f32, usize)> = None;
+            for (k, (&uk, &rk)) in self.u.iter().zip(r.iter()).enumerate().take(q) {
+                if rk > 0.0 {
+                    let t = uk / rk;
+                    if t1.is_none_or(|(best, _)| t < best) {
+                        t1 = Some((t, k));
+                    }
+                }
+            }
+            let zn = dot_n(&z, np, self.n);
+            let s = dot_n(np, &self.x, self.n) + cp;
+            // Full step: the row satisfied exactly.
+            let t2 = (zn > TINY).then(|| -s / zn);
+            let (t, drop) = match (t1, t2) {
+                (None, None) => return Err(QpError::Incompatible),
+                (Some((a, k)), Some(b)) if a < b => (a, Some(k)),
+                (Some((a, k)), None) => (a, Some(k)),
+                (_, Some(b)) => (b, None),
+            };
+            if !t.is_finite() {
+                return Err(QpError::Incompatible);
+            }
+            if t2.is_some() {
+                self.x += z * t;
+            }
+            for (uk, &rk) in self.u.iter_mut().zip(r.iter()).take(q) {
+                *uk -= t * rk;
+            }
+            u_new += t;
+            match drop {
+                None => return self.enter(d, p, u_new),
+                Some(k) => self.leave(k),
+            }
+        }
+        Err(QpError::Iterations)
+    }
+
+    /// `R⁻¹ d₁` over the `q` active rows.
+    fn back_substitute(&self, d: &SVector<f32, K>, q: usize) -> [f32; K] {
+        let mut r = [0.0_f32; K];
+        for i in (0..q).rev() {
+            let mut s = vat(d, i);
+            for (k, &rk) in r.iter().enumerate().take(q).skip(i.saturating_add(1)) {
+                s -= at(&self.r, i, k) * rk;
+            }
+            let rii = at(&self.r, i, i);
+            if let Some(slot) = r.get_mut(i) {
+                *slot = if rii != 0.0 { s / rii } else { 0.0 };
+            }
+        }
+        r
+    }
+
+    /// Row `p` enters: `d = Jᵀ n_p` is rotated so that its entries past
+    /// `q` vanish into entry `q`, which with `d₁` is `R`'s new column.
+    fn enter(&mut self, mut d: SVector<f32, K>, p: usize, u: f32) -> Result<(), QpError> {
+        let q = self.active.len();
+        let mut k = self.n.saturating_sub(1);
+        while k > q {
+            let (a, b) = (vat(&d, k.saturating_sub(1)), vat(&d, k));
+            if b != 0.0 {
+                let (c, s, h) = givens(a, b);
+                reflect_columns(&mut self.j, k.saturating_sub(1), (c, s));
+                if let Some(e) = d.get_mut(k.saturating_sub(1)) {
+                    *e = h;
+                }
+                if let Some(e) = d.get_mut(k) {
+                    *e = 0.0;
+                }
+            }
+            k = k.saturating_sub(1);
+        }
+        let rqq = vat(&d, q);
+        if libm::fabsf(rqq) <= TINY {
+            // Dependent on the active rows: cannot enter.
+            return Err(QpError::Incompatible);
+        }
+        for i in 0..=q {
+            put(&mut self.r, i, q, vat(&d, i));
+        }
+        self.active.push(p).map_err(|_| QpError::Iterations)?;
+        self.u.push(u).map_err(|_| QpError::Iterations)?;
+        Ok(())
+    }
+
+    /// Active row `k` leaves: its column of `R` is removed and `R`
+    /// brought back to triangular form by reflections of rows (and of
+    /// `J`'s columns) `i, i + 1`, `i >= k`.
+    fn leave(&mut self, k: usize) {
+        let q = self.active.len();
+        if k >= q {
+            return;
+        }
+        for col in k..q.saturating_sub(1) {
+            for i in 0..K {
+                let v = at(&self.r, i, col.saturating_add(1));
+                put(&mut self.r, i, col, v);
+            }
+        }
+        for i in 0..K {
+            put(&mut self.r, i, q.saturating_sub(1), 0.0);
+        }
+        let _ = self.active.remove(k);
+        let _ = self.u.remove(k);
+        let q = q.saturating_sub(1);
+        for i in k..q {
+            let (a, b) = (at(&self.r, i, i), at(&self.r, i.saturating_add(1), i));
+            if b == 0.0 {
+                continue;
+            }
+            let (c, s, _) = givens(a, b);
+            for col in i..q {
+                let (x, y) = (at(&self.r, i, col), at(&self.r, i.saturating_add(1), col));
+                put(&mut self.r, i, col, c * x + s * y);
+                put(&mut self.r, i.saturating_add(1), col, s * x - c * y);
+            }
+            reflect_columns(&mut self.j, i, (c, s));
+        }
+    }
+
+    /// The step and the multipliers in the rows' own units.
+    fn solution(&self, m: usize, scale: &Vec<f32, QP_ROWS>) -> QpSolution<K> {
+        let mut lambda: Vec<f32, QP_ROWS> = Vec::new();
+        for _ in 0..m {
+            let _ = lambda.push(0.0);
+        }
+        for (&i, &u) in self.active.iter().zip(self.u.iter()) {
+            if let (Some(l), Some(&s)) = (lambda.get_mut(i), scale.get(i)) {
+                *l = u * s;
+            }
+        }
+        QpSolution { d: self.x, lambda }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::needless_range_loop)]
+mod tests {
+    extern crate std;
+    use super::*;
+    use std::vec;
+    use std::vec::Vec as SVec;
+
+    struct Lcg(u64);
+    impl Lcg {
+        fn unit(&mut self) -> f64 {
+            self.0 = self
+                .0
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (self.0 >> 11) as f64 / (1u64 << 53) as f64
+        }
+        fn sym(&mut self) -> f64 {
+            2.0 * self.unit() - 1.0
+        }
+    }
+
+    /// Brute force in f64: every active set of at most `n` rows, its
+    /// equality-constrained minimum, kept if feasible with multipliers
+    /// >= 0; the least objective wins.
+    fn brute(
+        g_mat: &[[f64; 4]; 4],
+        g: &[f64; 4],
+        n: usize,
+        rows: &[([f64; 4], f64)],
+    ) -> Option<(SVec<f64>, f64)> {
+        let m = rows.len();
+        let mut best: Option<(SVec<f64>, f64)> = None;
+        for mask in 0u32..(1 << m) {
+            let act: SVec<usize> = (0..m).filter(|i| mask >> i & 1 == 1).collect();
+            if act.len() > n {
+                continue;
+            }
+            // KKT: [G -Aᵀ; A 0] [d; λ] = [-g; -c]
+            let s = n + act.len();
+            let mut kk = vec![vec![0.0; s + 1]; s];
+            for i in 0..n {
+                for j in 0..n {
+                    kk[i][j] = g_mat[i][j];
+                }
+                for (k, &r) in act.iter().enumerate() {
+                    kk[i][n + k] = -rows[r].0[i];
+                    kk[n + k][i] = rows[r].0[i];
+                }
+                kk[i][s] = -g[i];
+            }
+            for (k, &r) in act.iter().enumerate() {
+                kk[n + k][s] = -rows[r].1;
+            }
+            // Gaussian elimination with pivoting.
+            let mut ok = true;
+            for c in 0..s {
+                let p = (c..s)
+                    .max_by(|&a, &b| kk[a][c].abs().total_cmp(&kk[b][c].abs()))
+                    .unwrap();
+                if kk[p][c].abs() < 1e-12 {
+                    ok = false;
+                    break;
+                }
+                kk.swap(c, p);
+                for r in 0..s {
+                    if r != c {
+                        let f = kk[r][c] / kk[c][c];
+                        for k in c..=s {
+                            kk[r][k] -= f * kk[c][k];
+                        }
+                    }
+                }
+            }
+            if !ok {
+                continue;
+            }
+            let sol: SVec<f64> = (0..s).map(|i| kk[i][s] / kk[i][i]).collect();
+            let d = &sol[..n];
+            if sol[n..].iter().any(|&l| l < -1e-9) {
+                continue;
+            }
+            if rows
+                .iter()
+                .any(|(a, c)| (0..n).map(|i| a[i] * d[i]).sum::<f64>() + c < -1e-7)
+            {
+                continue;
+            }
+            let f: f64 = (0..n)
+                .map(|i| 0.5 * d[i] * (0..n).map(|j| g_mat[i][j] * d[j]).sum::<f64>() + g[i] * d[i])
+                .sum();
+            if best.as_ref().is_none_or(|b| f < b.1) {
+                best = Some((d.to_vec(), f));
+            }
+        }
+        best
+    }
+
+    #[test]
+    fn matches_brute_force_on_random_problems() {
+        let mut rng = Lcg(7);
+        let mut solved = 0;
+        for case in 0..400 {
+            let n = 1 + (rng.unit() * 4.0) as usize;
+            let m = (rng.unit() * 9.0) as usize;
+            // G = BᵀB + small I, scaled over decades.
+            let mut b = [[0.0f64; 4]; 4];
+            for row in b.iter_mut() {
+                for v in row.iter_mut() {
+                    *v = rng.sym();
+                }
+            }
+            let scale = 10f64.powf(rng.sym() * 3.0);
+            let mut gm = [[0.0f64; 4]; 4];
+            for i in 0..4 {
+                for j in 0..4 {
+                    gm[i][j] = scale
+                        * ((0..4).map(|k| b[k][i] * b[k][j]).sum::<f64>()
+                            + if i == j { 0.1 } else { 0.0 });
+                }
+            }
+            let g: [f64; 4] = core::array::from_fn(|_| scale * 10.0 * rng.sym());
+            let mut rows: SVec<([f64; 4], f64)> = (0..m)
+                .map(|_| (core::array::from_fn(|_| rng.sym()), 5.0 * rng.sym()))
+                .collect();
+            // Near-parallel rows, as neighbouring segments of one track
+            // give: a copy of a row nudged by 1e-3.
+            if m > 0 && m < 9 && case % 3 == 0 {
+                let (a, c) = rows[0];
+                rows.push((a.map(|v| v + 1e-3 * rng.sym()), c + 1e-3 * rng.sym()));
+            }
+            let expect = brute(&gm, &g, n, &rows);
+            let g_mat = SMatrix::<f32, 4, 4>::from_fn(|i, j| gm[i][j] as f32);
+            let gv = SVector::<f32, 4>::from_fn(|i, _| g[i] as f32);
+            let qrows: Vec<Row<4>, QP_ROWS> = rows
+                .iter()
+                .map(|(a, c)| Row {
+                    a: a.map(|v| v as f32),
+                    c: *c as f32,
+                })
+                .collect();
+            let got = solve(&g_mat, &gv, n, &qrows);
+            match (expect, got) {
+                (Some((d, _)), Ok(sol)) => {
+                    solved += 1;
+                    let dn = d.iter().map(|v| v.abs()).fold(1.0, f64::max);
+                    for i in 0..n {
+                        assert!(
+                            (sol.d[i] as f64 - d[i]).abs() <= 2e-3 * dn,
+                            "case {case}: d {:?} vs {d:?}",
+                            sol.d
+                        );
+                    }
+                    for i in n..4 {
+                        assert_eq!(sol.d[i], 0.0);
+                    }
+                    assert!(sol.lambda.iter().all(|&l| l >= 0.0));
+                }
+                (None, Err(_)) => {}
+                (e, g) => panic!("case {case}: brute {e:?}, solver {g:?}"),
+            }
+        }
+        std::println!("{solved} of 400 solved");
+        assert!(solved > 250, "{solved}");
+    }
+
+    #[test]
+    fn unconstrained_and_bound() {
+        let g_mat = SMatrix::<f32, 2, 2>::new(2.0, 0.0, 0.0, 2.0);
+        let g = SVector::<f32, 2>::new(-2.0, -4.0);
+        let sol = solve(&g_mat, &g, 2, &[]).unwrap();
+        assert!((sol.d[0] - 1.0).abs() < 1e-6 && (sol.d[1] - 2.0).abs() < 1e-6);
+        // d1 <= 1: -d1 + 1 >= 0.
+        let rows = [Row {
+            a: [0.0, -1.0],
+            c: 1.0,
+        }];
+        let sol = solve(&g_mat, &g, 2, &rows).unwrap();
+        assert!((sol.d[1] - 1.0).abs() < 1e-5, "{:?}", sol.d);
+        assert!((sol.lambda[0] - 2.0).abs() < 1e-4, "{:?}", sol.lambda);
+        // Incompatible: d0 >= 1 and d0 <= 0.
+        let rows = [
+            Row {
+                a: [1.0, 0.0],
+                c: -1.0,
+            },
+            Row {
+                a: [-1.0, 0.0],
+                c: 0.0,
+            },
+        ];
+        assert_eq!(solve(&g_mat, &g, 2, &rows), Err(QpError::Incompatible));
+    }
+}
