@@ -20,7 +20,8 @@
 //! are in the unit of `d` (m for the planner).
 
 use heapless::Vec;
-use nalgebra::{SMatrix, SVector};
+
+use super::dense::{Mat, at, backward, cholesky, dot, forward, put};
 
 /// Most constraint rows of one problem.
 pub(crate) const QP_ROWS: usize = 64;
@@ -29,7 +30,7 @@ pub(crate) const QP_ROWS: usize = 64;
 const ITERATIONS: usize = 4 * QP_ROWS;
 
 /// A row is violated when `aᵀd + c < -VIOLATION` (after scaling to a unit
-/// gradient: metres of `d`), relative to the problem's scale.
+/// gradient: metres of `d`).
 const VIOLATION: f32 = 1e-5;
 
 /// A row whose gradient is shorter than this is ignored.
@@ -53,11 +54,28 @@ pub(crate) enum QpError {
     Iterations,
 }
 
+/// The rows of a problem, read in place.
+pub(crate) trait Rows<const K: usize> {
+    /// How many.
+    fn count(&self) -> usize;
+    /// Row `i < count()`.
+    fn row(&self, i: usize) -> Option<Row<K>>;
+}
+
+impl<const K: usize> Rows<K> for [Row<K>] {
+    fn count(&self) -> usize {
+        self.len()
+    }
+    fn row(&self, i: usize) -> Option<Row<K>> {
+        self.get(i).copied()
+    }
+}
+
 /// The solution: the step `d` and one multiplier per row (`λᵢ >= 0`,
 /// zero for inactive rows), in the rows' own unit.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct QpSolution<const K: usize> {
-    pub d: SVector<f32, K>,
+    pub d: [f32; K],
     pub lambda: Vec<f32, QP_ROWS>,
 }
 
@@ -66,54 +84,41 @@ struct Work<const K: usize> {
     /// Variables used.
     n: usize,
     /// `J = L⁻ᵀ Q`: columns `0..q` span the active gradients.
-    j: SMatrix<f32, K, K>,
+    j: Mat<K>,
     /// Upper triangular `R` (`q × q` in the top left).
-    r: SMatrix<f32, K, K>,
+    r: Mat<K>,
     /// Active rows and their multipliers.
     active: Vec<usize, K>,
     u: Vec<f32, K>,
-    x: SVector<f32, K>,
+    x: [f32; K],
 }
 
-fn at<const K: usize>(m: &SMatrix<f32, K, K>, i: usize, j: usize) -> f32 {
-    m.get((i, j)).copied().unwrap_or(0.0)
-}
-
-fn put<const K: usize>(m: &mut SMatrix<f32, K, K>, i: usize, j: usize, v: f32) {
-    if let Some(e) = m.get_mut((i, j)) {
-        *e = v;
-    }
-}
-
-fn vat<const K: usize>(v: &SVector<f32, K>, i: usize) -> f32 {
-    v.get(i).copied().unwrap_or(0.0)
-}
-
-/// `aᵀb` over the first `n` entries, in index order.
-fn dot_n<const K: usize>(a: &SVector<f32, K>, b: &SVector<f32, K>, n: usize) -> f32 {
-    a.iter()
-        .zip(b.iter())
-        .take(n)
-        .fold(0.0, |s, (x, y)| s + x * y)
-}
-
-/// The Givens reflection `(c, s)` taking `(a, b)` to `(h, 0)`, `h >= 0`.
+/// The Givens reflection `(c, s)` taking `(a, b)` to `(h, 0)`, `h >= 0`
+/// (`√(a² + b²)` scaled by the larger magnitude against overflow, in f32:
+/// libm's `hypotf` works in f64, which a Cortex-M4F does in software).
 fn givens(a: f32, b: f32) -> (f32, f32, f32) {
-    let h = libm::hypotf(a, b);
-    if h > 0.0 {
-        (a / h, b / h, h)
-    } else {
-        (1.0, 0.0, 0.0)
+    let m = libm::fabsf(a).max(libm::fabsf(b));
+    if !(m > 0.0 && m.is_finite()) {
+        return (1.0, 0.0, 0.0);
     }
+    let (x, y) = (a / m, b / m);
+    let h = m * libm::sqrtf(x * x + y * y);
+    (a / h, b / h, h)
 }
 
-/// Columns `p`, `p + 1` of `m` reflected by `(c, s)`: `(c x + s y, s x − c y)`.
-fn reflect_columns<const K: usize>(m: &mut SMatrix<f32, K, K>, p: usize, (c, s): (f32, f32)) {
+/// Columns `p`, `p + 1` of the first `n` rows of `m` reflected by
+/// `(c, s)`: `(c x + s y, s x − c y)`.
+fn reflect_columns<const K: usize>(m: &mut Mat<K>, n: usize, p: usize, (c, s): (f32, f32)) {
     let q = p.saturating_add(1);
-    for k in 0..K {
-        let (x, y) = (at(m, k, p), at(m, k, q));
-        put(m, k, p, c * x + s * y);
-        put(m, k, q, s * x - c * y);
+    for row in m.iter_mut().take(n) {
+        if let (Some(&x), Some(&y)) = (row.get(p), row.get(q)) {
+            if let Some(e) = row.get_mut(p) {
+                *e = c * x + s * y;
+            }
+            if let Some(e) = row.get_mut(q) {
+                *e = s * x - c * y;
+            }
+        }
     }
 }
 
@@ -122,90 +127,82 @@ fn reflect_columns<const K: usize>(m: &mut SMatrix<f32, K, K>, p: usize, (c, s):
 ///
 /// # Errors
 /// [`QpError`]: `G` not definite, rows incompatible, or the cap reached.
-pub(crate) fn solve<const K: usize>(
-    g_mat: &SMatrix<f32, K, K>,
-    g: &SVector<f32, K>,
+pub(crate) fn solve<const K: usize, R: Rows<K> + ?Sized>(
+    g_mat: &Mat<K>,
+    g: &[f32; K],
     n: usize,
-    rows: &[Row<K>],
+    rows: &R,
 ) -> Result<QpSolution<K>, QpError> {
     let n = n.min(K);
-    let rows = rows.get(..rows.len().min(QP_ROWS)).unwrap_or(&[]);
-    // Rows scaled to unit gradients (zero rows kept as zero: ignored).
-    let mut scale: Vec<f32, QP_ROWS> = Vec::new();
-    let mut norms: Vec<SVector<f32, K>, QP_ROWS> = Vec::new();
-    let mut cs: Vec<f32, QP_ROWS> = Vec::new();
-    for row in rows {
-        let a = SVector::<f32, K>::from_fn(|i, _| {
-            if i < n {
-                row.a.get(i).copied().unwrap_or(0.0)
-            } else {
-                0.0
-            }
-        });
-        let len = libm::sqrtf(dot_n(&a, &a, n));
-        let s = if len > TINY && len.is_finite() {
+    let m = rows.count().min(QP_ROWS);
+    // Each row `i` is used as `(aᵢ, cᵢ) · scale[i]`: a unit gradient over
+    // the first `n` variables (a row without one is ignored).
+    let mut scale = [0.0_f32; QP_ROWS];
+    for (i, s) in scale.iter_mut().enumerate().take(m) {
+        let Some(r) = rows.row(i) else { continue };
+        let len = libm::sqrtf(dot(&r.a, &r.a, n));
+        *s = if len > TINY && len.is_finite() {
             1.0 / len
         } else {
             0.0
         };
-        let _ = scale.push(s);
-        let _ = norms.push(a * s);
-        let _ = cs.push(row.c * s);
     }
+    let unit = |i: usize| -> Option<([f32; K], f32)> {
+        let s = *scale.get(i)?;
+        let r = rows.row(i)?;
+        let mut a = [0.0; K];
+        for (dst, &src) in a.iter_mut().zip(r.a.iter()).take(n) {
+            *dst = src * s;
+        }
+        (s > 0.0).then_some((a, r.c * s))
+    };
     let mut w = Work::start(g_mat, g, n)?;
-    let mut added = [false; QP_ROWS];
     for _ in 0..ITERATIONS {
         // The most violated row not active.
         let mut worst: Option<(usize, f32)> = None;
-        for (i, (a, &c)) in norms.iter().zip(cs.iter()).enumerate() {
-            if scale.get(i).is_none_or(|&s| s == 0.0) || added.get(i).copied().unwrap_or(true) {
+        for i in 0..m {
+            if w.active.contains(&i) {
                 continue;
             }
-            let s = dot_n(a, &w.x, n) + c;
+            let Some((a, c)) = unit(i) else { continue };
+            let s = dot(&a, &w.x, n) + c;
             if s < -VIOLATION && worst.is_none_or(|(_, v)| s < v) {
                 worst = Some((i, s));
             }
         }
         let Some((p, _)) = worst else {
-            return Ok(w.solution(rows.len(), &scale));
+            return Ok(w.solution(m, &scale));
         };
-        let np = norms.get(p).copied().unwrap_or_else(SVector::zeros);
-        let cp = cs.get(p).copied().unwrap_or(0.0);
+        let Some((np, cp)) = unit(p) else {
+            return Err(QpError::Incompatible);
+        };
         w.add(&np, cp, p)?;
-        // (Rows dropped on the way may enter again.)
-        for (i, flag) in added.iter_mut().enumerate() {
-            *flag = w.active.contains(&i);
-        }
     }
     Err(QpError::Iterations)
 }
 
 impl<const K: usize> Work<K> {
     /// The unconstrained minimum `x = −G⁻¹ g`, `J = L⁻ᵀ`, nothing active.
-    fn start(g_mat: &SMatrix<f32, K, K>, g: &SVector<f32, K>, n: usize) -> Result<Self, QpError> {
-        // Only the used block; the rest is the identity (held at zero).
-        let m = SMatrix::<f32, K, K>::from_fn(|i, j| match (i < n, j < n) {
-            (true, true) => at(g_mat, i, j),
-            _ if i == j => 1.0,
-            _ => 0.0,
-        });
-        if !m.iter().all(|v| v.is_finite()) {
-            return Err(QpError::NotDefinite);
+    fn start(g_mat: &Mat<K>, g: &[f32; K], n: usize) -> Result<Self, QpError> {
+        let l = cholesky(g_mat, n).ok_or(QpError::NotDefinite)?;
+        // Row i of J = L⁻ᵀ is L⁻¹ eᵢ.
+        let mut j = [[0.0; K]; K];
+        for (i, row) in j.iter_mut().enumerate().take(n) {
+            let mut e = [0.0; K];
+            if let Some(v) = e.get_mut(i) {
+                *v = 1.0;
+            }
+            *row = forward(&l, &e, n);
         }
-        let chol = m.cholesky().ok_or(QpError::NotDefinite)?;
-        let l = chol.l();
-        let l_inv = l
-            .solve_lower_triangular(&SMatrix::identity())
-            .ok_or(QpError::NotDefinite)?;
-        let gn = SVector::<f32, K>::from_fn(|i, _| if i < n { vat(g, i) } else { 0.0 });
-        let x = -chol.solve(&gn);
-        if !x.iter().all(|v| v.is_finite()) {
+        let mut x = backward(&l, &forward(&l, g, n), n);
+        x.iter_mut().for_each(|v| *v = -*v);
+        if !x.iter().chain(j.iter().flatten()).all(|v| v.is_finite()) {
             return Err(QpError::NotDefinite);
         }
         Ok(Self {
             n,
-            j: l_inv.transpose(),
-            r: SMatrix::zeros(),
+            j,
+            r: [[0.0; K]; K],
             active: Vec::new(),
             u: Vec::new(),
             x,
@@ -214,15 +211,24 @@ impl<const K: usize> Work<K> {
 
     /// Adds row `p` (`npᵀ x + cp >= 0`, currently violated): partial steps
     /// drop active rows until a full step satisfies it and it enters.
-    fn add(&mut self, np: &SVector<f32, K>, cp: f32, p: usize) -> Result<(), QpError> {
+    fn add(&mut self, np: &[f32; K], cp: f32, p: usize) -> Result<(), QpError> {
+        let n = self.n;
         let mut u_new: f32 = 0.0;
         for _ in 0..=K {
             let q = self.active.len();
-            let d = self.j.transpose() * np;
+            // d = Jᵀ n_p.
+            let mut d = [0.0_f32; K];
+            for (k, dk) in d.iter_mut().enumerate().take(n) {
+                *dk = (0..n).fold(0.0, |s, i| {
+                    s + at(&self.j, i, k) * np.get(i).copied().unwrap_or(0.0)
+                });
+            }
             // Primal direction in the null space of the active rows.
-            let mut z = SVector::<f32, K>::zeros();
-            for k in q..self.n {
-                z += self.j.column(k) * vat(&d, k);
+            let mut z = [0.0_f32; K];
+            for (i, zi) in z.iter_mut().enumerate().take(n) {
+                *zi = (q..n).fold(0.0, |s, k| {
+                    s + at(&self.j, i, k) * d.get(k).copied().unwrap_or(0.0)
+                });
             }
             // Dual direction: R r = d₁.
             let r = self.back_substitute(&d, q);
@@ -236,8 +242,8 @@ impl<const K: usize> Work<K> {
                     }
                 }
             }
-            let zn = dot_n(&z, np, self.n);
-            let s = dot_n(np, &self.x, self.n) + cp;
+            let zn = dot(&z, np, n);
+            let s = dot(np, &self.x, n) + cp;
             // Full step: the row satisfied exactly.
             let t2 = (zn > TINY).then(|| -s / zn);
             let (t, drop) = match (t1, t2) {
@@ -250,7 +256,9 @@ impl<const K: usize> Work<K> {
                 return Err(QpError::Incompatible);
             }
             if t2.is_some() {
-                self.x += z * t;
+                for (xi, zi) in self.x.iter_mut().zip(z.iter()).take(n) {
+                    *xi += t * zi;
+                }
             }
             for (uk, &rk) in self.u.iter_mut().zip(r.iter()).take(q) {
                 *uk -= t * rk;
@@ -265,12 +273,12 @@ impl<const K: usize> Work<K> {
     }
 
     /// `R⁻¹ d₁` over the `q` active rows.
-    fn back_substitute(&self, d: &SVector<f32, K>, q: usize) -> [f32; K] {
+    fn back_substitute(&self, d: &[f32; K], q: usize) -> [f32; K] {
         let mut r = [0.0_f32; K];
         for i in (0..q).rev() {
-            let mut s = vat(d, i);
-            for (k, &rk) in r.iter().enumerate().take(q).skip(i.saturating_add(1)) {
-                s -= at(&self.r, i, k) * rk;
+            let mut s = d.get(i).copied().unwrap_or(0.0);
+            for k in i.saturating_add(1)..q {
+                s -= at(&self.r, i, k) * r.get(k).copied().unwrap_or(0.0);
             }
             let rii = at(&self.r, i, i);
             if let Some(slot) = r.get_mut(i) {
@@ -282,30 +290,34 @@ impl<const K: usize> Work<K> {
 
     /// Row `p` enters: `d = Jᵀ n_p` is rotated so that its entries past
     /// `q` vanish into entry `q`, which with `d₁` is `R`'s new column.
-    fn enter(&mut self, mut d: SVector<f32, K>, p: usize, u: f32) -> Result<(), QpError> {
+    fn enter(&mut self, mut d: [f32; K], p: usize, u: f32) -> Result<(), QpError> {
         let q = self.active.len();
         let mut k = self.n.saturating_sub(1);
         while k > q {
-            let (a, b) = (vat(&d, k.saturating_sub(1)), vat(&d, k));
+            let below = k.saturating_sub(1);
+            let (a, b) = (
+                d.get(below).copied().unwrap_or(0.0),
+                d.get(k).copied().unwrap_or(0.0),
+            );
             if b != 0.0 {
                 let (c, s, h) = givens(a, b);
-                reflect_columns(&mut self.j, k.saturating_sub(1), (c, s));
-                if let Some(e) = d.get_mut(k.saturating_sub(1)) {
+                reflect_columns(&mut self.j, self.n, below, (c, s));
+                if let Some(e) = d.get_mut(below) {
                     *e = h;
                 }
                 if let Some(e) = d.get_mut(k) {
                     *e = 0.0;
                 }
             }
-            k = k.saturating_sub(1);
+            k = below;
         }
-        let rqq = vat(&d, q);
+        let rqq = d.get(q).copied().unwrap_or(0.0);
         if libm::fabsf(rqq) <= TINY {
             // Dependent on the active rows: cannot enter.
             return Err(QpError::Incompatible);
         }
-        for i in 0..=q {
-            put(&mut self.r, i, q, vat(&d, i));
+        for (i, &di) in d.iter().enumerate().take(q.saturating_add(1)) {
+            put(&mut self.r, i, q, di);
         }
         self.active.push(p).map_err(|_| QpError::Iterations)?;
         self.u.push(u).map_err(|_| QpError::Iterations)?;
@@ -320,35 +332,50 @@ impl<const K: usize> Work<K> {
         if k >= q {
             return;
         }
-        for col in k..q.saturating_sub(1) {
-            for i in 0..K {
-                let v = at(&self.r, i, col.saturating_add(1));
-                put(&mut self.r, i, col, v);
+        for row in self.r.iter_mut().take(q) {
+            for col in k..q.saturating_sub(1) {
+                let next = row.get(col.saturating_add(1)).copied().unwrap_or(0.0);
+                if let Some(e) = row.get_mut(col) {
+                    *e = next;
+                }
+            }
+            if let Some(e) = row.get_mut(q.saturating_sub(1)) {
+                *e = 0.0;
             }
         }
-        for i in 0..K {
-            put(&mut self.r, i, q.saturating_sub(1), 0.0);
+        // (By hand: `remove` asserts its index, and moves by `memmove`.)
+        for i in k..q.saturating_sub(1) {
+            let next = i.saturating_add(1);
+            if let (Some(&a), Some(&u)) = (self.active.get(next), self.u.get(next)) {
+                if let Some(slot) = self.active.get_mut(i) {
+                    *slot = a;
+                }
+                if let Some(slot) = self.u.get_mut(i) {
+                    *slot = u;
+                }
+            }
         }
-        let _ = self.active.remove(k);
-        let _ = self.u.remove(k);
+        self.active.truncate(q.saturating_sub(1));
+        self.u.truncate(q.saturating_sub(1));
         let q = q.saturating_sub(1);
         for i in k..q {
-            let (a, b) = (at(&self.r, i, i), at(&self.r, i.saturating_add(1), i));
+            let next = i.saturating_add(1);
+            let (a, b) = (at(&self.r, i, i), at(&self.r, next, i));
             if b == 0.0 {
                 continue;
             }
             let (c, s, _) = givens(a, b);
             for col in i..q {
-                let (x, y) = (at(&self.r, i, col), at(&self.r, i.saturating_add(1), col));
+                let (x, y) = (at(&self.r, i, col), at(&self.r, next, col));
                 put(&mut self.r, i, col, c * x + s * y);
-                put(&mut self.r, i.saturating_add(1), col, s * x - c * y);
+                put(&mut self.r, next, col, s * x - c * y);
             }
-            reflect_columns(&mut self.j, i, (c, s));
+            reflect_columns(&mut self.j, self.n, i, (c, s));
         }
     }
 
     /// The step and the multipliers in the rows' own units.
-    fn solution(&self, m: usize, scale: &Vec<f32, QP_ROWS>) -> QpSolution<K> {
+    fn solution(&self, m: usize, scale: &[f32; QP_ROWS]) -> QpSolution<K> {
         let mut lambda: Vec<f32, QP_ROWS> = Vec::new();
         for _ in 0..m {
             let _ = lambda.push(0.0);
@@ -494,8 +521,8 @@ mod tests {
                 rows.push((a.map(|v| v + 1e-3 * rng.sym()), c + 1e-3 * rng.sym()));
             }
             let expect = brute(&gm, &g, n, &rows);
-            let g_mat = SMatrix::<f32, 4, 4>::from_fn(|i, j| gm[i][j] as f32);
-            let gv = SVector::<f32, 4>::from_fn(|i, _| g[i] as f32);
+            let g_mat: Mat<4> = core::array::from_fn(|i| core::array::from_fn(|j| gm[i][j] as f32));
+            let gv: [f32; 4] = core::array::from_fn(|i| g[i] as f32);
             let qrows: Vec<Row<4>, QP_ROWS> = rows
                 .iter()
                 .map(|(a, c)| Row {
@@ -503,7 +530,7 @@ mod tests {
                     c: *c as f32,
                 })
                 .collect();
-            let got = solve(&g_mat, &gv, n, &qrows);
+            let got = solve(&g_mat, &gv, n, &qrows[..]);
             match (expect, got) {
                 (Some((d, _)), Ok(sol)) => {
                     solved += 1;
@@ -530,16 +557,16 @@ mod tests {
 
     #[test]
     fn unconstrained_and_bound() {
-        let g_mat = SMatrix::<f32, 2, 2>::new(2.0, 0.0, 0.0, 2.0);
-        let g = SVector::<f32, 2>::new(-2.0, -4.0);
-        let sol = solve(&g_mat, &g, 2, &[]).unwrap();
+        let g_mat: Mat<2> = [[2.0, 0.0], [0.0, 2.0]];
+        let g = [-2.0, -4.0];
+        let sol = solve(&g_mat, &g, 2, &[][..]).unwrap();
         assert!((sol.d[0] - 1.0).abs() < 1e-6 && (sol.d[1] - 2.0).abs() < 1e-6);
         // d1 <= 1: -d1 + 1 >= 0.
         let rows = [Row {
             a: [0.0, -1.0],
             c: 1.0,
         }];
-        let sol = solve(&g_mat, &g, 2, &rows).unwrap();
+        let sol = solve(&g_mat, &g, 2, &rows[..]).unwrap();
         assert!((sol.d[1] - 1.0).abs() < 1e-5, "{:?}", sol.d);
         assert!((sol.lambda[0] - 2.0).abs() < 1e-4, "{:?}", sol.lambda);
         // Incompatible: d0 >= 1 and d0 <= 0.
@@ -553,6 +580,6 @@ mod tests {
                 c: 0.0,
             },
         ];
-        assert_eq!(solve(&g_mat, &g, 2, &rows), Err(QpError::Incompatible));
+        assert_eq!(solve(&g_mat, &g, 2, &rows[..]), Err(QpError::Incompatible));
     }
 }

@@ -35,14 +35,14 @@
 //! iteration cap, or no acceptable step (`LineSearchFailed`).
 
 use heapless::Vec;
-use nalgebra::SMatrix;
 
-use super::qp::{self, QP_ROWS, QpError, Row};
-use super::{BfgsConfig, Bounds, OptimError, Outcome, Status, Vector, dot};
+use super::dense::{Mat, at, dot, mul, put};
+use super::qp::{self, QP_ROWS, QpError, Row, Rows};
+use super::{BfgsConfig, Bounds, OptimError, Outcome, Status, Vector};
 
 /// Most constraint rows an objective gives (the rest of the QP's rows are
 /// the box's).
-pub(crate) const CONSTRAINTS: usize = 48;
+pub(crate) const CONSTRAINTS: usize = 32;
 
 /// A step whose largest component is below this (m) is no step.
 pub(crate) const STEP_TOL: f32 = 1e-3;
@@ -56,16 +56,10 @@ const RELAXATIONS: [f32; 4] = [0.0, 0.5, 0.9, 1.0];
 /// Relative regularization of the metric's diagonal in the QP.
 const REGULARIZATION: f32 = 1e-6;
 
-/// One constraint `c >= 0` at the point (m), with its gradient (m/m) and
-/// its group (for the planner: the track).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct Constraint<const K: usize> {
-    pub c: f32,
-    pub a: [f32; K],
-    pub group: u8,
-}
-
-/// An objective's linearization at a point.
+/// An objective's linearization at a point: `J`, its gradient, and the
+/// constraint rows `cᵢ >= 0` with their gradients, in the same order at
+/// every point (for the planner: one per segment, grouped by track), the
+/// rows' storage laid out for the objective to fill in place.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Linearized<const K: usize> {
     /// `J`, m³.
@@ -74,13 +68,19 @@ pub(crate) struct Linearized<const K: usize> {
     pub grad: [f32; K],
     /// ℓ1 infeasibility `v`, m.
     pub infeasibility: f32,
-    /// Every constraint, in the same order at every point.
-    pub rows: Vec<Constraint<K>, CONSTRAINTS>,
+    /// Rows used.
+    pub rows: usize,
+    /// Each row's `c`, m (`+inf`: no constraint there).
+    pub c: [f32; CONSTRAINTS],
+    /// Each row's gradient, m/m.
+    pub a: [[f32; K]; CONSTRAINTS],
+    /// Each row's group (for the planner: the track).
+    pub group: [u8; CONSTRAINTS],
     /// Rows with `c` above this (m) stay out of the QP: too far from
     /// active for their linearization to matter.
     pub band: f32,
     /// The Gauss–Newton matrix of `J` (m), when asked for.
-    pub gn: SMatrix<f32, K, K>,
+    pub gn: Mat<K>,
 }
 
 impl<const K: usize> Default for Linearized<K> {
@@ -89,10 +89,25 @@ impl<const K: usize> Default for Linearized<K> {
             j: f32::INFINITY,
             grad: [0.0; K],
             infeasibility: 0.0,
-            rows: Vec::new(),
+            rows: 0,
+            c: [f32::INFINITY; CONSTRAINTS],
+            a: [[0.0; K]; CONSTRAINTS],
+            group: [0; CONSTRAINTS],
             band: f32::INFINITY,
-            gn: SMatrix::zeros(),
+            gn: [[0.0; K]; K],
         }
+    }
+}
+
+impl<const K: usize> Linearized<K> {
+    /// `(c, ∇c, group)` of the rows used.
+    fn iter(&self) -> impl Iterator<Item = (f32, &[f32; K], u8)> + '_ {
+        self.c
+            .iter()
+            .zip(self.a.iter())
+            .zip(self.group.iter())
+            .take(self.rows)
+            .map(|((&c, a), &g)| (c, a, g))
     }
 }
 
@@ -140,93 +155,133 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         return Err(OptimError::Config(super::OptimConfigError::Bounds));
     }
     let n = n.min(K);
-    let mut z = bounds.project_v(&Vector::from(*z0));
-    let mut lin = Linearized::default();
-    obj.linearize(&z.into(), true, &mut lin)
+    let mut run = Run {
+        z: bounds.project(z0),
+        lin: Linearized::default(),
+        a: [[0.0; K]; K],
+        rho: 0.0,
+        evaluations: 1,
+        iterations: 0,
+        skipped: 0,
+    };
+    obj.linearize(&run.z, true, &mut run.lin)
         .map_err(OptimError::Start)?;
-    if !(lin.j.is_finite() && lin.grad.iter().all(|g| g.is_finite())) {
+    if !(run.lin.j.is_finite() && run.lin.grad.iter().all(|g| g.is_finite())) {
         return Err(OptimError::NonFinite);
     }
-    let mut a = initial_metric(&lin.gn, n);
-    let mut rho = 0.0_f32;
-    let mut evaluations = 1_u32;
-    let mut iterations = 0_u32;
-    let mut skipped = 0_u32;
-    let _ = out.history.push(lin.j);
+    run.a = initial_metric(&run.lin.gn, n);
+    let _ = out.history.push(run.lin.j);
     let status = loop {
-        if iterations >= cfg.max_iterations {
+        if run.iterations >= cfg.max_iterations {
             break Status::MaxIterations;
         }
-        let Some((d, lambda, sigma)) = step(&a, &lin, &z, bounds, n, cfg.max_step) else {
-            break Status::LineSearchFailed;
-        };
-        rho = rho.max(RHO_FACTOR * largest_group(&lin, &lambda));
-        let phi = lin.j + rho * lin.infeasibility;
-        let g = Vector::from(lin.grad);
-        let slope = dot(&g, &d) - rho * (1.0 - sigma) * lin.infeasibility;
-        let feasible = lin.infeasibility <= feas_tol;
-        // The QP's model of the decrease of `J` (3.14b's threshold, as
-        // BFGS): below it, feasible, the step is not worth a flight.
-        let model = -(dot(&g, &d) + 0.5 * dot(&d, &(a * d)));
-        if feasible && (d.amax() <= STEP_TOL || model <= cfg.tol.j_threshold(lin.j)) {
-            break Status::Converged;
+        if let Some(stop) = run.iterate(obj, (bounds, n), cfg, feas_tol) {
+            break stop;
         }
-        if slope >= 0.0 {
-            break if feasible {
-                Status::Converged
-            } else {
-                Status::LineSearchFailed
-            };
-        }
-        let Some((zt, alpha, tried)) = search(obj, (&z, &d), bounds, (phi, slope, rho), cfg) else {
-            evaluations = evaluations.saturating_add(cfg.armijo.max_backtracks);
-            break Status::LineSearchFailed;
-        };
-        evaluations = evaluations.saturating_add(tried);
-        let old = lagrangian_gradient(&lin, &lambda);
-        if obj.linearize(&zt.into(), false, &mut lin).is_err() {
-            break Status::LineSearchFailed;
-        }
-        evaluations = evaluations.saturating_add(1);
-        let new = lagrangian_gradient(&lin, &lambda);
-        if !update(&mut a, &(zt - z), &(new - old)) {
-            skipped = skipped.saturating_add(1);
-        }
-        z = zt;
-        iterations = iterations.saturating_add(1);
-        let phi_new = lin.j + rho * lin.infeasibility;
-        let _ = out.history.push(lin.j);
-        crate::log::debug!(
-            "sqp iteration {=u32}: J {=f32} m3, v {=f32} m, rho {=f32}, alpha {=f32}",
-            iterations,
-            lin.j,
-            lin.infeasibility,
-            rho,
-            alpha
-        );
-        let small = libm::fabsf(phi - phi_new) <= cfg.tol.j_threshold(phi_new);
-        if alpha >= 1.0 && small && lin.infeasibility <= feas_tol {
-            break Status::Converged;
-        }
+        let _ = out.history.push(run.lin.j);
     };
-    out.z = z.into();
-    out.j = lin.j;
-    out.gradient = lin.grad;
-    out.grad_norm = bounds.free_gradient_norm_v(&z, &Vector::from(lin.grad));
+    let z = Vector::from(run.z);
+    out.z = run.z;
+    out.j = run.lin.j;
+    out.gradient = run.lin.grad;
+    out.grad_norm = bounds.free_gradient_norm_v(&z, &Vector::from(run.lin.grad));
     out.status = status;
-    out.iterations = iterations;
-    out.evaluations = evaluations;
-    out.skipped_updates = skipped;
+    out.iterations = run.iterations;
+    out.evaluations = run.evaluations;
+    out.skipped_updates = run.skipped;
     Ok(())
 }
 
+/// The state of one SQP run.
+struct Run<const K: usize> {
+    z: [f32; K],
+    lin: Linearized<K>,
+    /// The BFGS metric.
+    a: Mat<K>,
+    /// The merit's penalty weight.
+    rho: f32,
+    evaluations: u32,
+    iterations: u32,
+    skipped: u32,
+}
+
+impl<const K: usize> Run<K> {
+    /// One iteration: the QP step, the line search, the new linearization
+    /// and the metric's update; `Some` with the status when the run ends.
+    fn iterate<O: Constrained<K>>(
+        &mut self,
+        obj: &mut O,
+        (bounds, n): (&Bounds<K>, usize),
+        cfg: &BfgsConfig,
+        feas_tol: f32,
+    ) -> Option<Status> {
+        let lin = &self.lin;
+        let Some((d, lambda, sigma)) = step(&self.a, lin, &self.z, (bounds, n), cfg.max_step)
+        else {
+            return Some(Status::LineSearchFailed);
+        };
+        self.rho = self.rho.max(RHO_FACTOR * largest_group(lin, &lambda));
+        let phi = lin.j + self.rho * lin.infeasibility;
+        let gd = dot(&lin.grad, &d, n);
+        let slope = gd - self.rho * (1.0 - sigma) * lin.infeasibility;
+        let feasible = lin.infeasibility <= feas_tol;
+        // The QP's model of the decrease of `J` (3.14b's threshold, as
+        // BFGS): below it, feasible, the step is not worth a flight.
+        let model = -(gd + 0.5 * dot(&d, &mul(&self.a, &d, n), n));
+        let longest = d.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)));
+        if feasible && (longest <= STEP_TOL || model <= cfg.tol.j_threshold(lin.j)) {
+            return Some(Status::Converged);
+        }
+        if slope >= 0.0 {
+            return Some(if feasible {
+                Status::Converged
+            } else {
+                Status::LineSearchFailed
+            });
+        }
+        let merit = (phi, slope, self.rho);
+        let Some((zt, alpha, tried)) = search(obj, (&self.z, &d), bounds, merit, cfg) else {
+            self.evaluations = self.evaluations.saturating_add(cfg.armijo.max_backtracks);
+            return Some(Status::LineSearchFailed);
+        };
+        self.evaluations = self.evaluations.saturating_add(tried);
+        let old = lagrangian_gradient(&self.lin, &lambda);
+        if obj.linearize(&zt, false, &mut self.lin).is_err() {
+            return Some(Status::LineSearchFailed);
+        }
+        self.evaluations = self.evaluations.saturating_add(1);
+        let new = lagrangian_gradient(&self.lin, &lambda);
+        let s: [f32; K] = core::array::from_fn(|i| {
+            zt.get(i).copied().unwrap_or(0.0) - self.z.get(i).copied().unwrap_or(0.0)
+        });
+        let y: [f32; K] = core::array::from_fn(|i| {
+            new.get(i).copied().unwrap_or(0.0) - old.get(i).copied().unwrap_or(0.0)
+        });
+        if !update(&mut self.a, &s, &y, n) {
+            self.skipped = self.skipped.saturating_add(1);
+        }
+        self.z = zt;
+        self.iterations = self.iterations.saturating_add(1);
+        let lin = &self.lin;
+        let phi_new = lin.j + self.rho * lin.infeasibility;
+        crate::log::debug!(
+            "sqp iteration {=u32}: J {=f32} m3, v {=f32} m, rho {=f32}, alpha {=f32}",
+            self.iterations,
+            lin.j,
+            lin.infeasibility,
+            self.rho,
+            alpha
+        );
+        let small = libm::fabsf(phi - phi_new) <= cfg.tol.j_threshold(phi_new);
+        (alpha >= 1.0 && small && lin.infeasibility <= feas_tol).then_some(Status::Converged)
+    }
+}
+
 /// The first metric: the Gauss–Newton matrix over the first `n`
-/// variables, the identity on the held ones.
-fn initial_metric<const K: usize>(gn: &SMatrix<f32, K, K>, n: usize) -> SMatrix<f32, K, K> {
-    SMatrix::from_fn(|i, j| match (i < n, j < n) {
-        (true, true) => gn.get((i, j)).copied().unwrap_or(0.0),
-        _ if i == j => 1.0,
-        _ => 0.0,
+/// variables (zero past them).
+fn initial_metric<const K: usize>(gn: &Mat<K>, n: usize) -> Mat<K> {
+    core::array::from_fn(|i| {
+        core::array::from_fn(|j| if i < n && j < n { at(gn, i, j) } else { 0.0 })
     })
 }
 
@@ -234,42 +289,37 @@ fn initial_metric<const K: usize>(gn: &SMatrix<f32, K, K>, n: usize) -> SMatrix<
 /// relaxation `σ` that makes the QP compatible; `None` when none does
 /// (the metric not definite).
 fn step<const K: usize>(
-    a: &SMatrix<f32, K, K>,
+    a: &Mat<K>,
     lin: &Linearized<K>,
-    z: &Vector<K>,
-    bounds: &Bounds<K>,
-    n: usize,
+    z: &[f32; K],
+    (bounds, n): (&Bounds<K>, usize),
     max_step: f32,
-) -> Option<(Vector<K>, Vec<f32, CONSTRAINTS>, f32)> {
-    let mean = (0..n)
-        .map(|i| a.get((i, i)).copied().unwrap_or(0.0))
-        .fold(0.0, |s, v| s + v)
-        / (n.max(1) as f32);
+) -> Option<([f32; K], Vec<f32, CONSTRAINTS>, f32)> {
+    let mean = (0..n).fold(0.0, |s, i| s + at(a, i, i)) / (n.max(1) as f32);
     let delta = REGULARIZATION * mean.max(0.0) + REGULARIZATION;
-    let a_reg = SMatrix::<f32, K, K>::from_fn(|i, j| {
-        let v = a.get((i, j)).copied().unwrap_or(0.0);
-        if i == j && i < n { v + delta } else { v }
-    });
-    let g = Vector::<K>::from(lin.grad);
+    let mut a_reg = *a;
+    for i in 0..n {
+        put(&mut a_reg, i, i, at(a, i, i) + delta);
+    }
     for &sigma in &RELAXATIONS {
-        let (rows, index) = qp_rows(lin, z, bounds, n, sigma);
-        match qp::solve(&a_reg, &g, n, &rows) {
+        let rows = StepRows::new(lin, (z, bounds, n), sigma);
+        match qp::solve(&a_reg, &lin.grad, n, &rows) {
             Ok(sol) => {
                 let mut lambda: Vec<f32, CONSTRAINTS> = Vec::new();
-                for _ in 0..lin.rows.len() {
+                for _ in 0..lin.rows {
                     let _ = lambda.push(0.0);
                 }
-                for (&l, &i) in sol.lambda.iter().zip(index.iter()) {
-                    if let Some(slot) = lambda.get_mut(usize::from(i)) {
+                for (i, &l) in sol.lambda.iter().enumerate().take(rows.general) {
+                    let at = rows.index.get(i).map(|&k| usize::from(k));
+                    if let Some(slot) = at.and_then(|k| lambda.get_mut(k)) {
                         *slot = l;
                     }
                 }
-                let longest = sol.d.amax();
-                let d = if longest > max_step {
-                    sol.d * (max_step / longest)
-                } else {
-                    sol.d
-                };
+                let longest = sol.d.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)));
+                let mut d = sol.d;
+                if longest > max_step {
+                    d.iter_mut().for_each(|v| *v *= max_step / longest);
+                }
                 return Some((d, lambda, sigma));
             }
             Err(QpError::Incompatible | QpError::Iterations) => {}
@@ -279,52 +329,78 @@ fn step<const K: usize>(
     None
 }
 
-/// The QP's rows at relaxation `σ`: the near-active constraints with a
-/// gradient (each with its index among the objective's rows), then the
-/// box around `z` (index `u8::MAX`).
-fn qp_rows<const K: usize>(
-    lin: &Linearized<K>,
-    z: &Vector<K>,
-    bounds: &Bounds<K>,
+/// The QP's rows at relaxation `σ`, read in place: the near-active
+/// constraints with a gradient (`index`: which of the objective's rows),
+/// then two box rows per variable around `z`.
+struct StepRows<'l, const K: usize> {
+    lin: &'l Linearized<K>,
+    index: [u8; CONSTRAINTS],
+    general: usize,
+    z: &'l [f32; K],
+    bounds: &'l Bounds<K>,
     n: usize,
     sigma: f32,
-) -> (Vec<Row<K>, QP_ROWS>, Vec<u8, QP_ROWS>) {
-    let mut rows: Vec<Row<K>, QP_ROWS> = Vec::new();
-    let mut index: Vec<u8, QP_ROWS> = Vec::new();
-    for (i, r) in lin.rows.iter().enumerate() {
-        let moves = r.a.iter().take(n).any(|&v| v != 0.0);
-        if !(moves && r.c < lin.band && r.c.is_finite()) {
-            continue;
-        }
-        let c = if r.c < 0.0 { (1.0 - sigma) * r.c } else { r.c };
-        if rows.push(Row { a: r.a, c }).is_ok() {
-            let _ = index.push(u8::try_from(i).unwrap_or(u8::MAX));
-        }
-    }
-    for i in 0..n {
-        let (Some(&zi), Some(&lo), Some(&hi)) = (z.get(i), bounds.lo.get(i), bounds.hi.get(i))
-        else {
-            continue;
-        };
-        let mut up = [0.0; K];
-        let mut down = [0.0; K];
-        if let (Some(u), Some(d)) = (up.get_mut(i), down.get_mut(i)) {
-            *u = 1.0;
-            *d = -1.0;
-        }
-        for row in [
-            Row { a: up, c: zi - lo },
-            Row {
-                a: down,
-                c: hi - zi,
-            },
-        ] {
-            if rows.push(row).is_ok() {
-                let _ = index.push(u8::MAX);
+}
+
+impl<'l, const K: usize> StepRows<'l, K> {
+    fn new(
+        lin: &'l Linearized<K>,
+        (z, bounds, n): (&'l [f32; K], &'l Bounds<K>, usize),
+        sigma: f32,
+    ) -> Self {
+        let mut index = [0_u8; CONSTRAINTS];
+        let mut general = 0_usize;
+        for (i, (c, a, _)) in lin.iter().enumerate() {
+            let moves = a.iter().take(n).any(|&v| v != 0.0);
+            if moves
+                && c < lin.band
+                && c.is_finite()
+                && let Some(slot) = index.get_mut(general)
+            {
+                *slot = u8::try_from(i).unwrap_or(u8::MAX);
+                general = general.saturating_add(1);
             }
         }
+        Self {
+            lin,
+            index,
+            general,
+            z,
+            bounds,
+            n,
+            sigma,
+        }
     }
-    (rows, index)
+}
+
+impl<const K: usize> Rows<K> for StepRows<'_, K> {
+    fn count(&self) -> usize {
+        self.general
+            .saturating_add(self.n.saturating_mul(2))
+            .min(QP_ROWS)
+    }
+
+    fn row(&self, i: usize) -> Option<Row<K>> {
+        if i < self.general {
+            let k = usize::from(*self.index.get(i)?);
+            let (&c, &a) = (self.lin.c.get(k)?, self.lin.a.get(k)?);
+            let c = if c < 0.0 { (1.0 - self.sigma) * c } else { c };
+            return Some(Row { a, c });
+        }
+        let b = i.checked_sub(self.general)?;
+        let (v, up) = (b / 2, b % 2 == 0);
+        let (&zi, &lo, &hi) = (
+            self.z.get(v)?,
+            self.bounds.lo.get(v)?,
+            self.bounds.hi.get(v)?,
+        );
+        let mut a = [0.0; K];
+        *a.get_mut(v)? = if up { 1.0 } else { -1.0 };
+        Some(Row {
+            a,
+            c: if up { zi - lo } else { hi - zi },
+        })
+    }
 }
 
 /// The largest sum of multipliers over one group (groups `0..K`; a row
@@ -332,8 +408,8 @@ fn qp_rows<const K: usize>(
 fn largest_group<const K: usize>(lin: &Linearized<K>, lambda: &[f32]) -> f32 {
     let mut sums = [0.0_f32; K];
     let mut best = 0.0_f32;
-    for (r, &l) in lin.rows.iter().zip(lambda.iter()) {
-        match sums.get_mut(usize::from(r.group)) {
+    for ((_, _, group), &l) in lin.iter().zip(lambda.iter()) {
+        match sums.get_mut(usize::from(group)) {
             Some(s) => *s += l,
             None => best = best.max(l),
         }
@@ -342,11 +418,13 @@ fn largest_group<const K: usize>(lin: &Linearized<K>, lambda: &[f32]) -> f32 {
 }
 
 /// `∇J − Σ λᵢ ∇cᵢ` (the box's rows are linear: they cancel in BFGS's `y`).
-fn lagrangian_gradient<const K: usize>(lin: &Linearized<K>, lambda: &[f32]) -> Vector<K> {
-    let mut g = Vector::from(lin.grad);
-    for (r, &l) in lin.rows.iter().zip(lambda.iter()) {
+fn lagrangian_gradient<const K: usize>(lin: &Linearized<K>, lambda: &[f32]) -> [f32; K] {
+    let mut g = lin.grad;
+    for ((_, a, _), &l) in lin.iter().zip(lambda.iter()) {
         if l > 0.0 {
-            g -= Vector::from(r.a) * l;
+            for (gi, ai) in g.iter_mut().zip(a.iter()) {
+                *gi -= l * ai;
+            }
         }
     }
     g
@@ -357,20 +435,28 @@ fn lagrangian_gradient<const K: usize>(lin: &Linearized<K>, lambda: &[f32]) -> V
 /// `None` when none within the cap.
 fn search<const K: usize, O: Constrained<K>>(
     obj: &mut O,
-    (z, d): (&Vector<K>, &Vector<K>),
+    (z, d): (&[f32; K], &[f32; K]),
     bounds: &Bounds<K>,
     (phi, slope, rho): (f32, f32, f32),
     cfg: &BfgsConfig,
-) -> Option<(Vector<K>, f32, u32)> {
+) -> Option<([f32; K], f32, u32)> {
     let mut alpha = 1.0_f32;
     let mut tried = 0_u32;
     for _ in 0..=cfg.armijo.max_backtracks {
-        let zt = bounds.project_v(&(z + d * alpha));
-        if zt == *z {
+        let trial: [f32; K] = core::array::from_fn(|i| {
+            z.get(i).copied().unwrap_or(0.0) + alpha * d.get(i).copied().unwrap_or(0.0)
+        });
+        let zt = bounds.project(&trial);
+        // No move at all (pinned by the box, or α underflowed).
+        if zt
+            .iter()
+            .zip(z.iter())
+            .all(|(a, b)| a.to_bits() == b.to_bits())
+        {
             return None;
         }
         tried = tried.saturating_add(1);
-        let merit = match obj.value(&zt.into()) {
+        let merit = match obj.value(&zt) {
             Ok((j, v)) => j + rho * v,
             Err(_) => return None,
         };
@@ -384,17 +470,18 @@ fn search<const K: usize, O: Constrained<K>>(
         } else {
             0.1 * alpha
         };
-        alpha = next.clamp(0.1 * alpha, 0.5 * alpha);
+        // (Not `clamp`, which asserts its bounds.)
+        alpha = next.min(0.5 * alpha).max(0.1 * alpha);
     }
     None
 }
 
 /// Powell's damped BFGS update of `a` for step `s` and Lagrangian gradient
-/// change `y`; returns whether it was made.
-fn update<const K: usize>(a: &mut SMatrix<f32, K, K>, s: &Vector<K>, y: &Vector<K>) -> bool {
-    let bs = *a * s;
-    let sbs = dot(s, &bs);
-    let sy = dot(s, y);
+/// change `y` over the first `n` variables; returns whether it was made.
+fn update<const K: usize>(a: &mut Mat<K>, s: &[f32; K], y: &[f32; K], n: usize) -> bool {
+    let bs = mul(a, s, n);
+    let sbs = dot(s, &bs, n);
+    let sy = dot(s, y, n);
     if !(sbs > 0.0 && sbs.is_finite() && sy.is_finite()) {
         return false;
     }
@@ -403,15 +490,38 @@ fn update<const K: usize>(a: &mut SMatrix<f32, K, K>, s: &Vector<K>, y: &Vector<
     } else {
         0.8 * sbs / (sbs - sy)
     };
-    let r = y * theta + bs * (1.0 - theta);
-    let sr = dot(s, &r);
+    let r: [f32; K] = core::array::from_fn(|i| {
+        theta * y.get(i).copied().unwrap_or(0.0) + (1.0 - theta) * bs.get(i).copied().unwrap_or(0.0)
+    });
+    let sr = dot(s, &r, n);
     if sr.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
         return false;
     }
-    let next = *a + r * (r.transpose() / sr) - bs * (bs.transpose() / sbs);
-    if !next.iter().all(|v| v.is_finite()) {
+    let mut next = *a;
+    for i in 0..n {
+        for j in 0..n {
+            let (ri, rj) = (
+                r.get(i).copied().unwrap_or(0.0),
+                r.get(j).copied().unwrap_or(0.0),
+            );
+            let (bi, bj) = (
+                bs.get(i).copied().unwrap_or(0.0),
+                bs.get(j).copied().unwrap_or(0.0),
+            );
+            put(&mut next, i, j, at(a, i, j) + ri * rj / sr - bi * bj / sbs);
+        }
+    }
+    if !next.iter().flatten().all(|v| v.is_finite()) {
         return false;
     }
-    *a = (next + next.transpose()) * 0.5;
+    // Symmetric against rounding.
+    for i in 0..n {
+        for j in 0..i {
+            let m = 0.5 * (at(&next, i, j) + at(&next, j, i));
+            put(&mut next, i, j, m);
+            put(&mut next, j, i, m);
+        }
+    }
+    *a = next;
     true
 }

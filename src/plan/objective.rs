@@ -4,7 +4,7 @@
 //! with their exact gradients from the tangent pass.
 
 use crate::optim::Objective;
-use crate::optim::sqp::{Constrained, Constraint, Linearized};
+use crate::optim::sqp::{Constrained, Linearized};
 use crate::sim::{Scenario, SimError, TrackScore, VehicleState, Watch};
 
 /// Why [`PlanObjective`] did not return a value: the flight failed, the
@@ -253,31 +253,27 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
         self.count_flight()?;
         let wp = self.sc.waypoints().positions();
         let h_r = self.sc.mission().reference_altitude();
-        let mut watch = Watch::<K>::new(wp, self.track, self.count, h_r, gn);
+        let records = (&mut out.c[..], &mut out.a[..], &mut out.group[..]);
+        let (mut watch, rows) = Watch::new(
+            (wp, self.track, self.count),
+            h_r,
+            records,
+            gn.then_some(&mut out.gn),
+        );
         let e = self
             .sc
             .evaluate_watched(self.start, self.track, z, self.count, &mut watch)
             .map_err(Stop::Sim)?;
+        out.rows = rows;
+        // Each segment's least altitude above its track's target.
+        let targets = (self.target.0, self.target.1);
+        for (c, &t) in out.c.iter_mut().zip(out.group.iter()).take(rows) {
+            *c -= if t == 0 { targets.0 } else { targets.1 };
+        }
         out.j = e.j;
         out.grad = e.grad_j;
         out.infeasibility = self.infeasibility(&e.scores);
         out.band = self.band;
-        out.rows.clear();
-        for s in 0..watch.segments {
-            let (Some(&m), Some(g), Some(&t)) =
-                (watch.min.get(s), watch.grad.get(s), watch.track.get(s))
-            else {
-                continue;
-            };
-            let _ = out.rows.push(Constraint {
-                c: m - self.target_of(usize::from(t)),
-                a: *g,
-                group: t,
-            });
-        }
-        if let Some(m) = watch.gn {
-            out.gn = m;
-        }
         self.last_violation = out.infeasibility;
         self.last_min_altitude = e.min_altitude;
         self.last_flight = None;

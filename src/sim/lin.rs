@@ -54,6 +54,15 @@ pub(crate) trait Sensitivity<const N: usize> {
     fn step(&mut self, vehicle: &Vehicle<N>, lin: &StepLin);
     /// After a piece of the newest segment was scored into track `slot`.
     fn piece(&mut self, slot: usize, lin: &PieceLin);
+    /// Step `k` and then the piece it flew, scored wholly into its own
+    /// track `slot` (the fast path): as [`Sensitivity::step`] then
+    /// [`Sensitivity::piece`], which a tangent pass may do in one pass
+    /// over its columns.
+    #[inline(always)]
+    fn step_piece(&mut self, vehicle: &Vehicle<N>, lin: &StepLin, slot: usize, piece: &PieceLin) {
+        self.step(vehicle, lin);
+        self.piece(slot, piece);
+    }
 }
 
 /// The plain simulation's hook: does nothing, and compiles to nothing.
@@ -64,4 +73,6 @@ impl<const N: usize> Sensitivity<N> for NoSensitivity {
     fn step(&mut self, _: &Vehicle<N>, _: &StepLin) {}
     #[inline(always)]
     fn piece(&mut self, _: usize, _: &PieceLin) {}
+    #[inline(always)]
+    fn step_piece(&mut self, _: &Vehicle<N>, _: &StepLin, _: usize, _: &PieceLin) {}
 }

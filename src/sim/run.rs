@@ -315,7 +315,7 @@ impl<const N: usize> Scenario<'_, N> {
             };
             budget = left;
             let at = (&mut st, &mut pitch, &mut rise);
-            let (dx, dd) = match self.advance(at, (r, track, slot), sens, observe) {
+            let (dx, dd, lin) = match self.step_alone(at, (r, track, slot), observe) {
                 Ok(v) => v,
                 Err(e) => {
                     acc.j.add(0.25 * j_run);
@@ -325,6 +325,8 @@ impl<const N: usize> Scenario<'_, N> {
             };
             // (NaN leaves the fast path too.)
             if st.x.value().partial_cmp(&fast_limit) != Some(core::cmp::Ordering::Less) {
+                // The general path scores this step.
+                sens.step(self.vehicle, &lin);
                 break;
             }
             fast = true;
@@ -361,7 +363,12 @@ impl<const N: usize> Scenario<'_, N> {
                 };
             }
             let ends = ((&a0, st.x_prev.value()), (&a1, st.x.value()));
-            sens.piece(slot, &piece_within(dx, dd, ends.0, ends.1));
+            sens.step_piece(
+                self.vehicle,
+                &lin,
+                slot,
+                &piece_within(dx, dd, ends.0, ends.1),
+            );
             e2 = e2_next;
             a0 = a1;
         }
@@ -413,11 +420,26 @@ impl<const N: usize> Scenario<'_, N> {
     #[inline(always)]
     fn advance<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
         &self,
-        (st, pitch, rise): (&mut VehicleState<N>, &mut f32, &mut f32),
-        (r, track, slot): (f32, usize, usize),
+        at: (&mut VehicleState<N>, &mut f32, &mut f32),
+        ref_track_slot: (f32, usize, usize),
         sens: &mut Sn,
         observe: &mut F,
     ) -> Result<(f32, f32), SimError> {
+        let (dx, dd, lin) = self.step_alone(at, ref_track_slot, observe)?;
+        sens.step(self.vehicle, &lin);
+        Ok((dx, dd))
+    }
+
+    /// [`Scenario::advance`] without handing the linearization on: it is
+    /// returned with the increments, for the fast path to hand on with
+    /// the step's piece.
+    #[inline(always)]
+    fn step_alone<F: FnMut(&Sample)>(
+        &self,
+        (st, pitch, rise): (&mut VehicleState<N>, &mut f32, &mut f32),
+        (r, track, slot): (f32, usize, usize),
+        observe: &mut F,
+    ) -> Result<(f32, f32, StepLin), SimError> {
         let plant = self.vehicle.plant();
         let ts = plant.sample_time();
         let pitch_rate = plant.pitch_rate_v(&st.eta);
@@ -473,17 +495,14 @@ impl<const N: usize> Scenario<'_, N> {
         st.depth = st.depth.add(dd);
         st.x = st.x.add(dx);
         *rise = dd;
-        sens.step(
-            self.vehicle,
-            &StepLin {
-                slot,
-                command,
-                sin,
-                cos,
-                step: k.step,
-            },
-        );
-        Ok((dx, dd))
+        let lin = StepLin {
+            slot,
+            command,
+            sin,
+            cos,
+            step: k.step,
+        };
+        Ok((dx, dd, lin))
     }
 }
 

@@ -30,13 +30,13 @@
 //! clamp's edge, and it is exactly zero on the plateaus where the pitch
 //! reference stays saturated over a whole track (contract §10).
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 use crate::model::Vehicle;
 use crate::num::DEG;
 
 use super::lin::{EndAt, PieceLin, Sensitivity, StepLin};
-use super::watch::{NoWatch, Watch, Watcher};
+use super::watch::Watch;
 use super::{Scenario, SimError, TrackScore, VehicleState};
 
 /// The tangent of the state with respect to one reference depth, and the
@@ -83,17 +83,132 @@ impl<const N: usize> Column<N> {
 /// per depth. Depth `j`'s column is exactly zero until its track begins
 /// (the start state and the earlier tracks do not depend on it), so each
 /// step and piece updates only the columns of the tracks begun so far.
-/// The watcher `W` sees every piece with the columns' `∂e` (`watch.rs`).
-struct Tangents<'w, const N: usize, const K: usize, W: Watcher<K>> {
+/// The watch sees every piece with the columns' `∂e` (`watch.rs`) when it
+/// records anything.
+struct Tangents<'w, 'a, const N: usize, const K: usize> {
     cols: [Column<N>; K],
-    watch: &'w mut W,
+    gains: Gains<N>,
+    /// Whether the watch records anything (read once).
+    watching: bool,
+    watch: &'w mut Watch<'a, K>,
 }
 
-impl<'w, const N: usize, const K: usize, W: Watcher<K>> Tangents<'w, N, K, W> {
-    /// The start state does not depend on `ζ`: every tangent is zero.
-    fn zero(watch: &'w mut W) -> Self {
+/// What every column's step multiplies by, gathered once per pass: the
+/// cascade's gains (the pitch loop's with its sign, the depth loop's `Kdd`
+/// over `Ts`), the plant, and `½ · π/180` for the mean pitch.
+#[derive(Clone, Copy)]
+struct Gains<const N: usize> {
+    kp: f32,
+    ki: f32,
+    kd_ts: f32,
+    pitch: (f32, f32, f32),
+    ts: f32,
+    ad: SMatrix<f32, N, N>,
+    bd: SVector<f32, N>,
+}
+
+impl<const N: usize> Gains<N> {
+    fn of(v: &Vehicle<N>) -> Self {
+        let plant = v.plant();
+        let ap = v.autopilot();
+        let cfg = ap.config();
+        let ts = plant.sample_time();
+        let sign = ap.loop_sign();
+        let (gd, gt) = (&cfg.depth_pid, &cfg.pitch_pid);
         Self {
+            kp: gd.kp,
+            ki: gd.ki,
+            kd_ts: gd.kd / ts,
+            pitch: (sign * gt.kp, sign * gt.ki, sign * gt.kd),
+            ts,
+            ad: *plant.ad_m(),
+            bd: *plant.bd_v(),
+        }
+    }
+}
+
+/// One step's factors: the clamps (1 or 0) and the integrators' switches
+/// (`Ts` or 0), the same for every column, and the kinematics' `½ U Ts
+/// cos θ̄ · π/180` and `… sin θ̄ …`.
+#[derive(Clone, Copy)]
+struct Factors {
+    pitch_ref: f32,
+    elevator: f32,
+    depth_integral: f32,
+    pitch_integral: f32,
+    dd: f32,
+    dx: f32,
+}
+
+impl Factors {
+    #[inline(always)]
+    fn of<const N: usize>(g: &Gains<N>, lin: &StepLin) -> Self {
+        let c = lin.command;
+        let on = |b: bool, v: f32| if b { v } else { 0.0 };
+        let half = 0.5 * DEG * lin.step;
+        Self {
+            pitch_ref: on(c.pitch_ref_linear, 1.0),
+            elevator: on(c.elevator_linear, 1.0),
+            depth_integral: on(c.depth_integrating, g.ts),
+            pitch_integral: on(c.pitch_integrating, g.ts),
+            dd: half * lin.cos,
+            dx: half * lin.sin,
+        }
+    }
+}
+
+impl<const N: usize> Column<N> {
+    /// One step of this column: the cascade's tangent (the clamps and
+    /// integrators as factors, so no branch), the plant's, the
+    /// kinematics'; `driven` for the column of the active track, whose
+    /// reference moves with its depth.
+    #[inline(always)]
+    fn step(&mut self, g: &Gains<N>, f: &Factors, driven: bool) {
+        let (kp_t, ki_t, kd_t) = g.pitch;
+        let pitch = self.eta.get(0).copied().unwrap_or(0.0);
+        let pitch_rate = self.eta.get(1).copied().unwrap_or(0.0);
+        let e_d = if driven { 1.0 - self.d } else { -self.d };
+        let v = g.kd_ts * (self.d - self.d_prev) - g.kp * e_d - g.ki * self.depth_integral;
+        let e_t = f.pitch_ref * v - pitch;
+        let w = f.elevator * (kp_t * e_t + ki_t * self.pitch_integral - kd_t * pitch_rate);
+        self.depth_integral += f.depth_integral * e_d;
+        self.pitch_integral += f.pitch_integral * e_t;
+        self.eta = g.ad * self.eta + g.bd * w;
+        let mean = pitch + self.eta.get(0).copied().unwrap_or(0.0);
+        self.d_prev = self.d;
+        self.x_prev = self.x;
+        self.d -= mean * f.dd;
+        self.x -= mean * f.dx;
+    }
+
+    /// [`Column::step`] and the piece it flew between samples on bottom
+    /// slopes `s0`, `s1` (`sq_e = ¼ (e_lo² + e_hi²)`, `he = ½ L e`);
+    /// returns `(∂e_lo, ∂e_hi)`.
+    #[inline(always)]
+    fn step_piece(
+        &mut self,
+        g: &Gains<N>,
+        f: &Factors,
+        driven: bool,
+        (s0, s1): (f32, f32),
+        (sq_e, he_lo, he_hi): (f32, f32, f32),
+    ) -> (f32, f32) {
+        let de_lo = self.x * s0 - self.d;
+        let x0 = self.x;
+        self.step(g, f, driven);
+        let de_hi = self.x * s1 - self.d;
+        self.grad_j += (self.x - x0) * sq_e + de_lo * he_lo + de_hi * he_hi;
+        (de_lo, de_hi)
+    }
+}
+
+impl<'w, 'a, const N: usize, const K: usize> Tangents<'w, 'a, N, K> {
+    /// The start state does not depend on `ζ`: every tangent is zero.
+    fn zero(vehicle: &Vehicle<N>, watch: &'w mut Watch<'a, K>) -> Self {
+        Self {
+            watching: watch.on(),
             watch,
+            gains: Gains::of(vehicle),
             cols: [Column {
                 eta: SVector::zeros(),
                 d: 0.0,
@@ -109,46 +224,73 @@ impl<'w, const N: usize, const K: usize, W: Watcher<K>> Tangents<'w, N, K, W> {
     }
 }
 
-impl<const N: usize, const K: usize, W: Watcher<K>> Sensitivity<N> for Tangents<'_, N, K, W> {
+impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
     #[inline(always)]
-    fn step(&mut self, v: &Vehicle<N>, lin: &StepLin) {
-        let plant = v.plant();
-        let ap = v.autopilot();
-        let cfg = ap.config();
-        let ts = plant.sample_time();
-        let (gd, gt) = (&cfg.depth_pid, &cfg.pitch_pid);
-        let (ad, bd) = (plant.ad_m(), plant.bd_v());
-        let sign = ap.loop_sign();
-        let c = lin.command;
-        let (dd, dx) = (lin.step * lin.cos, lin.step * lin.sin);
+    fn step(&mut self, _: &Vehicle<N>, lin: &StepLin) {
+        let f = Factors::of(&self.gains, lin);
         for (j, col) in self
             .cols
             .iter_mut()
             .enumerate()
             .take(lin.slot.saturating_add(1))
         {
-            let pitch = plant.pitch_v(&col.eta);
-            let pitch_rate = plant.pitch_rate_v(&col.eta);
-            let e_d = if j == lin.slot { 1.0 - col.d } else { -col.d };
-            let rate = (col.d - col.d_prev) / ts;
-            let v_ = -(e_d * gd.kp + col.depth_integral * gd.ki - rate * gd.kd);
-            let pitch_ref = if c.pitch_ref_linear { v_ } else { 0.0 };
-            let e_t = pitch_ref - pitch;
-            let w = (e_t * gt.kp + col.pitch_integral * gt.ki - pitch_rate * gt.kd) * sign;
-            let elevator = if c.elevator_linear { w } else { 0.0 };
-            if c.depth_integrating {
-                col.depth_integral += e_d * ts;
+            col.step(&self.gains, &f, j == lin.slot);
+        }
+    }
+
+    /// The fast path's step and its piece (both ends samples on one bottom
+    /// segment, inside the track) in one pass over the columns: each
+    /// column's state is loaded once, and the piece's ends are the states
+    /// before and after the step.
+    #[inline(always)]
+    fn step_piece(&mut self, v: &Vehicle<N>, lin: &StepLin, slot: usize, p: &PieceLin) {
+        let (EndAt::Start { slope: s0 }, EndAt::End { slope: s1 }) = (p.lo.at, p.hi.at) else {
+            self.step(v, lin);
+            self.piece(slot, p);
+            return;
+        };
+        if p.lo.p > 0.0 || p.hi.p > 0.0 {
+            self.step(v, lin);
+            self.piece(slot, p);
+            return;
+        }
+        let f = Factors::of(&self.gains, lin);
+        let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
+        let half = 0.5 * p.len;
+        let (he_lo, he_hi) = (half * p.lo.e, half * p.hi.e);
+        if self.watching {
+            let mut de = [(0.0, 0.0); K];
+            for ((j, col), de) in self
+                .cols
+                .iter_mut()
+                .enumerate()
+                .zip(de.iter_mut())
+                .take(lin.slot.saturating_add(1))
+            {
+                *de = col.step_piece(
+                    &self.gains,
+                    &f,
+                    j == lin.slot,
+                    (s0, s1),
+                    (sq_e, he_lo, he_hi),
+                );
             }
-            if c.pitch_integrating {
-                col.pitch_integral += e_t * ts;
+            self.watch.piece(slot, p, &de);
+        } else {
+            for (j, col) in self
+                .cols
+                .iter_mut()
+                .enumerate()
+                .take(lin.slot.saturating_add(1))
+            {
+                col.step_piece(
+                    &self.gains,
+                    &f,
+                    j == lin.slot,
+                    (s0, s1),
+                    (sq_e, he_lo, he_hi),
+                );
             }
-            col.eta = ad * col.eta + bd * elevator;
-            let pitch_next = plant.pitch_v(&col.eta);
-            let mean = (pitch + pitch_next) * (0.5 * DEG);
-            col.d_prev = col.d;
-            col.x_prev = col.x;
-            col.d -= mean * dd;
-            col.x -= mean * dx;
         }
     }
 
@@ -158,6 +300,8 @@ impl<const N: usize, const K: usize, W: Watcher<K>> Sensitivity<N> for Tangents<
         let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
         let sq_p = 0.25 * (p.lo.p * p.lo.p + p.hi.p * p.hi.p);
         let half = 0.5 * p.len;
+        let (he_lo, he_hi) = (half * p.lo.e, half * p.hi.e);
+        let violating = p.lo.p > 0.0 || p.hi.p > 0.0;
         let mut de = [(0.0, 0.0); K];
         for (col, de) in self
             .cols
@@ -167,17 +311,18 @@ impl<const N: usize, const K: usize, W: Watcher<K>> Sensitivity<N> for Tangents<
         {
             let de_lo = col.de(p.lo.at, ratio);
             let de_hi = col.de(p.hi.at, ratio);
-            if W::ACTIVE {
-                *de = (de_lo, de_hi);
-            }
+            *de = (de_lo, de_hi);
             let dlen = col.dx(p.hi.at) - col.dx(p.lo.at);
-            col.grad_j += dlen * sq_e + (de_lo * p.lo.e + de_hi * p.hi.e) * half;
-            // p = max(0, h_a − h) and e = h − h_r, so ∂p = −∂e where p > 0.
-            let dp_lo = if p.lo.p > 0.0 { -de_lo } else { 0.0 };
-            let dp_hi = if p.hi.p > 0.0 { -de_hi } else { 0.0 };
-            col.grad_violation += dlen * sq_p + (dp_lo * p.lo.p + dp_hi * p.hi.p) * half;
+            col.grad_j += dlen * sq_e + de_lo * he_lo + de_hi * he_hi;
+            // p = max(0, h_a − h) and e = h − h_r, so ∂p = −∂e where p > 0
+            // (nothing to add on the pieces clear of the penalty altitude).
+            if violating {
+                let dp_lo = if p.lo.p > 0.0 { -de_lo } else { 0.0 };
+                let dp_hi = if p.hi.p > 0.0 { -de_hi } else { 0.0 };
+                col.grad_violation += dlen * sq_p + (dp_lo * p.lo.p + dp_hi * p.hi.p) * half;
+            }
         }
-        if W::ACTIVE {
+        if self.watching {
             self.watch.piece(slot, p, &de);
         }
     }
@@ -235,7 +380,7 @@ impl<const N: usize> Scenario<'_, N> {
         depths: &[f32; K],
         count: usize,
     ) -> Result<Evaluation<N, K>, SimError> {
-        self.evaluate_with(start, first_track, depths, count, &mut NoWatch)
+        self.evaluate_watched(start, first_track, depths, count, &mut Watch::off())
     }
 
     /// As [`Scenario::evaluate_tracks`], recording the segments' least
@@ -245,29 +390,20 @@ impl<const N: usize> Scenario<'_, N> {
     ///
     /// # Errors
     /// As [`Scenario::evaluate_tracks`].
+    ///
+    /// The one tangent pass of the library: the plain gradient is this
+    /// pass with [`Watch::off`] (one copy of the loop in the firmware).
     pub(crate) fn evaluate_watched<const K: usize>(
         &self,
         start: &VehicleState<N>,
         first_track: usize,
         depths: &[f32; K],
         count: usize,
-        watch: &mut Watch<K>,
-    ) -> Result<Evaluation<N, K>, SimError> {
-        self.evaluate_with(start, first_track, depths, count, watch)
-    }
-
-    /// The one tangent pass, with its watcher.
-    fn evaluate_with<const K: usize, W: Watcher<K>>(
-        &self,
-        start: &VehicleState<N>,
-        first_track: usize,
-        depths: &[f32; K],
-        count: usize,
-        watch: &mut W,
+        watch: &mut Watch<'_, K>,
     ) -> Result<Evaluation<N, K>, SimError> {
         let used = depths.get(..count).ok_or(SimError::TrackRange)?;
         let mut scores = [TrackScore::default(); K];
-        let mut tan = Tangents::<N, K, W>::zero(watch);
+        let mut tan = Tangents::zero(self.vehicle, watch);
         let end =
             self.run::<_, _, true>(start, first_track, used, &mut scores, &mut tan, |_| {})?;
         let grad_j: [f32; K] = core::array::from_fn(|j| tan.cols.get(j).map_or(0.0, |c| c.grad_j));
