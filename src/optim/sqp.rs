@@ -138,13 +138,15 @@ pub(crate) trait Constrained<const K: usize> {
 /// the module docs with `cfg`'s iteration cap, tolerances and Armijo
 /// constant; the result is written into `out`, `J` at the start and at
 /// each iterate appended to `out.history` (not monotone: an early iterate
-/// may be infeasible, and lower).
+/// may be infeasible, and lower). `metric`: the first metric when given
+/// (a restart near a finished run keeps its curvature), else the
+/// Gauss–Newton matrix at `z0`; the final metric on return.
 ///
 /// # Errors
 /// [`OptimError`] when the objective fails or is not finite at the start.
 pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     obj: &mut O,
-    z0: &[f32; K],
+    (z0, metric): (&[f32; K], &mut Option<Mat<K>>),
     (bounds, n): (&Bounds<K>, usize),
     cfg: &BfgsConfig,
     feas_tol: f32,
@@ -164,21 +166,26 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         iterations: 0,
         skipped: 0,
     };
-    obj.linearize(&run.z, true, &mut run.lin)
+    obj.linearize(&run.z, metric.is_none(), &mut run.lin)
         .map_err(OptimError::Start)?;
     if !(run.lin.j.is_finite() && run.lin.grad.iter().all(|g| g.is_finite())) {
         return Err(OptimError::NonFinite);
     }
-    run.a = initial_metric(&run.lin.gn, n);
+    run.a = initial_metric(metric.as_ref().unwrap_or(&run.lin.gn), n);
     let _ = out.history.push(run.lin.j);
     let status = loop {
         if run.iterations >= cfg.max_iterations {
             break Status::MaxIterations;
         }
-        if let Some(stop) = run.iterate(obj, (bounds, n), cfg, feas_tol) {
+        let before = run.iterations;
+        let stop = run.iterate(obj, (bounds, n), cfg, feas_tol);
+        // One value per completed iteration, the last included.
+        if run.iterations != before {
+            let _ = out.history.push(run.lin.j);
+        }
+        if let Some(stop) = stop {
             break stop;
         }
-        let _ = out.history.push(run.lin.j);
     };
     let z = Vector::from(run.z);
     out.z = run.z;
@@ -189,6 +196,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     out.iterations = run.iterations;
     out.evaluations = run.evaluations;
     out.skipped_updates = run.skipped;
+    *metric = Some(run.a);
     Ok(())
 }
 
@@ -240,11 +248,17 @@ impl<const K: usize> Run<K> {
             });
         }
         let merit = (phi, slope, self.rho);
-        let Some((zt, alpha, tried)) = search(obj, (&self.z, &d), bounds, merit, cfg) else {
-            self.evaluations = self.evaluations.saturating_add(cfg.armijo.max_backtracks);
-            return Some(Status::LineSearchFailed);
-        };
+        let (found, tried) = search(obj, (&self.z, &d), bounds, merit, cfg);
         self.evaluations = self.evaluations.saturating_add(tried);
+        let Some((zt, alpha)) = found else {
+            // No acceptable step longer than `STEP_TOL`: a feasible point
+            // is as good as it gets here.
+            return Some(if feasible {
+                Status::Converged
+            } else {
+                Status::LineSearchFailed
+            });
+        };
         let old = lagrangian_gradient(&self.lin, &lambda);
         if obj.linearize(&zt, false, &mut self.lin).is_err() {
             return Some(Status::LineSearchFailed);
@@ -272,8 +286,12 @@ impl<const K: usize> Run<K> {
             self.rho,
             alpha
         );
+        // A feasible step that changed the merit by less than the relative
+        // tolerance (as BFGS's 3.14b), full or damped: a damped one near
+        // a kink of the constraints' minima would only crawl on.
         let small = libm::fabsf(phi - phi_new) <= cfg.tol.j_threshold(phi_new);
-        (alpha >= 1.0 && small && lin.infeasibility <= feas_tol).then_some(Status::Converged)
+        let _ = alpha;
+        (small && lin.infeasibility <= feas_tol).then_some(Status::Converged)
     }
 }
 
@@ -431,15 +449,16 @@ fn lagrangian_gradient<const K: usize>(lin: &Linearized<K>, lambda: &[f32]) -> [
 }
 
 /// Backtracking from the full step on the merit `φ = J + ρ v`: the first
-/// point with `φ <= φ₀ + c₁ α slope`, with its `α` and the flights tried;
-/// `None` when none within the cap.
+/// point with `φ <= φ₀ + c₁ α slope` and its `α` (`None` when none within
+/// the cap, or before the step is shorter than [`STEP_TOL`]), with the
+/// flights tried.
 fn search<const K: usize, O: Constrained<K>>(
     obj: &mut O,
     (z, d): (&[f32; K], &[f32; K]),
     bounds: &Bounds<K>,
     (phi, slope, rho): (f32, f32, f32),
     cfg: &BfgsConfig,
-) -> Option<([f32; K], f32, u32)> {
+) -> (Option<([f32; K], f32)>, u32) {
     let mut alpha = 1.0_f32;
     let mut tried = 0_u32;
     for _ in 0..=cfg.armijo.max_backtracks {
@@ -447,21 +466,21 @@ fn search<const K: usize, O: Constrained<K>>(
             z.get(i).copied().unwrap_or(0.0) + alpha * d.get(i).copied().unwrap_or(0.0)
         });
         let zt = bounds.project(&trial);
-        // No move at all (pinned by the box, or α underflowed).
-        if zt
+        // A step this short is no step (nor one pinned by the box).
+        let moved = zt
             .iter()
             .zip(z.iter())
-            .all(|(a, b)| a.to_bits() == b.to_bits())
-        {
-            return None;
+            .fold(0.0_f32, |m, (a, b)| m.max(libm::fabsf(a - b)));
+        if moved.partial_cmp(&STEP_TOL) != Some(core::cmp::Ordering::Greater) {
+            return (None, tried);
         }
         tried = tried.saturating_add(1);
         let merit = match obj.value(&zt) {
             Ok((j, v)) => j + rho * v,
-            Err(_) => return None,
+            Err(_) => return (None, tried),
         };
         if merit.is_finite() && merit <= phi + cfg.armijo.c1 * alpha * slope {
-            return Some((zt, alpha, tried));
+            return (Some((zt, alpha)), tried);
         }
         // A safeguarded quadratic through φ₀, the slope and the trial.
         let curvature = merit - phi - alpha * slope;
@@ -473,7 +492,7 @@ fn search<const K: usize, O: Constrained<K>>(
         // (Not `clamp`, which asserts its bounds.)
         alpha = next.min(0.5 * alpha).max(0.1 * alpha);
     }
-    None
+    (None, tried)
 }
 
 /// Powell's damped BFGS update of `a` for step `s` and Lagrangian gradient

@@ -23,14 +23,10 @@ pub(super) fn grid(lo: f32, hi: f32, k: u32, n: u32) -> f32 {
     }
 }
 
-/// The box of depths worth searching for each track of the horizon (see
-/// the module docs of [`crate::plan`]); variables past `h` are pinned.
-pub(super) fn search_box<const N: usize, const K: usize>(
-    sc: &Scenario<'_, N>,
-    state: &VehicleState<N>,
-    track: usize,
-    h: usize,
-) -> Bounds<K> {
+/// What the reach of a track's depth is made of: `sin` of the steepest
+/// flight path (a little over the pitch limit) and the depth error that
+/// saturates the pitch reference plus 20 m (m).
+fn reach_terms<const N: usize>(sc: &Scenario<'_, N>) -> (f32, f32) {
     let ap = sc.vehicle().autopilot().config();
     let angle = ((1.3 * ap.pitch_limit).min(90.0) * DEG).min(core::f32::consts::FRAC_PI_2);
     let (sin, _) = crate::num::sin_cos(angle);
@@ -39,10 +35,42 @@ pub(super) fn search_box<const N: usize, const K: usize>(
     } else {
         f32::INFINITY
     };
+    (sin, saturation + 20.0)
+}
+
+/// The depths of track `t` worth scanning from a state at depth `d` (m)
+/// at its start: within `d ± (L sin θ + saturation + 20 m)` (beyond, the
+/// pitch reference stays saturated over the whole track and the flight
+/// does not change), inside `[lo, hi]`.
+pub(super) fn reach_from<const N: usize>(
+    sc: &Scenario<'_, N>,
+    t: usize,
+    d: f32,
+    (lo, hi): (f32, f32),
+) -> (f32, f32) {
+    let (sin, base) = reach_terms(sc);
+    let wp = sc.waypoints().positions();
+    let len = match (wp.get(t), wp.get(t.saturating_add(1))) {
+        (Some(a), Some(b)) => b - a,
+        _ => 0.0,
+    };
+    let reach = base + len * sin;
+    ((d - reach).max(lo).min(hi), (d + reach).max(lo).min(hi))
+}
+
+/// The box of depths worth searching for each track of the horizon (see
+/// the module docs of [`crate::plan`]); variables past `h` are pinned.
+pub(super) fn search_box<const N: usize, const K: usize>(
+    sc: &Scenario<'_, N>,
+    state: &VehicleState<N>,
+    track: usize,
+    h: usize,
+) -> Bounds<K> {
+    let (sin, base) = reach_terms(sc);
     let [dmin, dmax] = sc.mission().depth_limits();
     let wp = sc.waypoints().positions();
     let d = state.depth();
-    let mut reach = saturation + 20.0;
+    let mut reach = base;
     let mut b = Bounds::<K>::uniform(dmin, dmin);
     for j in 0..h.min(K) {
         let t = track.saturating_add(j);
@@ -267,7 +295,7 @@ pub(super) fn scan_start<const N: usize, const K: usize>(
 }
 
 /// Paths kept by the horizon's beam scan at each track.
-const BEAM: usize = 4;
+const BEAM: usize = 2;
 
 /// One path of the beam scan: its depths so far, the objective they add
 /// up to and the state they leave.
@@ -348,6 +376,9 @@ fn beam_scan<const N: usize, const K: usize>(
         );
         let mut next: [Option<Path<N, K>>; BEAM] = [None; BEAM];
         for parent in beam.iter().flatten() {
+            // Each parent's own reach: beyond it the track flies the same.
+            let t = fl.track.saturating_add(j);
+            let (lo, hi) = reach_from(&fl.sc, t, parent.st.depth(), (lo, hi));
             for k in 0..n {
                 let z = grid(lo, hi, k, n);
                 let Ok((sc, end)) = fl.fly_from(&parent.st, j, z) else {

@@ -11,8 +11,12 @@ use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
 use crate::sim::{SimError, TrackScore};
 
 use super::objective::{PlanObjective, Stop};
-use super::scan::grid;
+use super::scan::{grid, reach_from};
 use super::{Method, PlanError, Planner};
+
+/// Rounds of the SQP's plateau escape: each scans every plateau, then
+/// restarts once from the best point found.
+const PLATEAU_ROUNDS: u32 = 2;
 
 /// Factor on `μ` between penalty stages.
 const PENALTY_GROWTH: f32 = 100.0;
@@ -94,7 +98,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         skip: u64,
     ) -> Result<(u32, u64), PlanError> {
         self.work.history.clear();
-        let run = sqp_into(obj, z0, (bounds, h), &self.cfg.bfgs, tol, &mut self.work);
+        let mut metric = None;
+        let run = sqp_into(
+            obj,
+            (z0, &mut metric),
+            (bounds, h),
+            &self.cfg.bfgs,
+            tol,
+            &mut self.work,
+        );
         let unstarted = matches!(run, Err(OptimError::Start(Stop::Budget)));
         if unstarted {
             self.work = crate::optim::Outcome::at(z0);
@@ -103,78 +115,150 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         run.map_err(start_error)?;
         let mut iterations = self.work.iterations;
         let mut scanned = 0_u64;
-        let cap = self.cfg.bfgs.max_iterations;
-        for j in 0..h {
-            let bit = u32::try_from(j)
-                .ok()
-                .and_then(|j| 1_u64.checked_shl(j))
-                .unwrap_or(0);
-            if iterations >= cap || skip & bit != 0 {
-                continue;
+        for _ in 0..PLATEAU_ROUNDS {
+            if iterations >= self.cfg.bfgs.max_iterations {
+                break;
             }
-            if self.work.gradient.get(j).is_some_and(|&g| g == 0.0) {
-                scanned |= bit;
+            // Every plateau's scan first, then one restart from the best.
+            let mut best: Option<(f32, [f32; K])> = None;
+            for j in 0..h {
+                let bit = u32::try_from(j)
+                    .ok()
+                    .and_then(|j| 1_u64.checked_shl(j))
+                    .unwrap_or(0);
+                // (The committed track's plateau is scanned again: it now
+                // has the first track's target.)
+                if (skip | scanned) & bit != 0 && j > 0 {
+                    continue;
+                }
+                if self.work.gradient.get(j).is_some_and(|&g| g == 0.0) {
+                    scanned |= bit;
+                }
+                if let Some(c) = self.sqp_plateau_jump(obj, bounds, j, tol)
+                    && best.as_ref().is_none_or(|b| c.0 < b.0)
+                {
+                    best = Some(c);
+                }
             }
-            let Some(z) = self.sqp_plateau_jump(obj, bounds, j, tol) else {
-                continue;
-            };
-            let acc = &self.work;
-            let kept = (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status);
-            let kept_counts = (acc.iterations, acc.evaluations, acc.history.len());
-            let left = BfgsConfig {
-                max_iterations: cap.saturating_sub(iterations).saturating_sub(1).max(1),
-                ..self.cfg.bfgs
-            };
-            let restart = sqp_into(obj, &z, (bounds, h), &left, tol, &mut self.work);
-            let acc = &mut self.work;
-            let better = restart.is_ok()
-                && obj.last_violation <= tol
-                && acc.j.partial_cmp(&kept.1) == Some(core::cmp::Ordering::Less);
-            if better {
-                iterations = iterations.saturating_add(acc.iterations).saturating_add(1);
-            } else {
-                (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
-                (acc.iterations, acc.evaluations) = (kept_counts.0, kept_counts.1);
-                acc.history.truncate(kept_counts.2);
+            let Some((_, z)) = best else { break };
+            match self.sqp_restart(obj, &z, (h, bounds), tol, iterations) {
+                Some(total) => iterations = total,
+                None => break,
             }
         }
         self.work.iterations = iterations;
         Ok((iterations, scanned | skip))
     }
 
-    /// The best feasible point of a scan of coordinate `j` over its box
-    /// when `∂J/∂z_j` is exactly zero (the pitch reference saturated over
-    /// the whole track), if its `J` beats the optimum's by more than the
-    /// stopping threshold.
+    /// The SQP restarted from `z` (a plateau's scan point), kept if it
+    /// ends better than the workspace's: feasible and lower, or, from an
+    /// infeasible optimum, less infeasible. Returns the iterations so far
+    /// when kept.
+    fn sqp_restart(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        z: &[f32; K],
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        iterations: u32,
+    ) -> Option<u32> {
+        let acc = &self.work;
+        let kept = (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status);
+        let kept_counts = (acc.iterations, acc.evaluations, acc.history.len());
+        let kept_v = obj.last_violation;
+        let left = BfgsConfig {
+            max_iterations: self
+                .cfg
+                .bfgs
+                .max_iterations
+                .saturating_sub(iterations)
+                .saturating_sub(1)
+                .max(1),
+            ..self.cfg.bfgs
+        };
+        // (A fresh metric: the plateau's row of the finished one is empty,
+        // its step there would be unbounded.)
+        let mut fresh = None;
+        let restart = sqp_into(
+            obj,
+            (z, &mut fresh),
+            (bounds, h),
+            &left,
+            tol,
+            &mut self.work,
+        );
+        let acc = &mut self.work;
+        let v = obj.last_violation;
+        let better = restart.is_ok()
+            && if kept_v > tol {
+                v < kept_v
+            } else {
+                v <= tol && acc.j.partial_cmp(&kept.1) == Some(core::cmp::Ordering::Less)
+            };
+        if better {
+            return Some(iterations.saturating_add(acc.iterations).saturating_add(1));
+        }
+        obj.last_violation = kept_v;
+        (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
+        (acc.iterations, acc.evaluations) = (kept_counts.0, kept_counts.1);
+        acc.history.truncate(kept_counts.2);
+        None
+    }
+
+    /// The best point of a scan of coordinate `j` when `∂J/∂z_j` is
+    /// exactly zero (the pitch reference saturated over the whole track:
+    /// no gradient, of `J` or of the altitudes after it, can move it), the
+    /// others held. From an infeasible optimum (shortfall `v` above `tol`,
+    /// m), the point of least `v` if it is less; from a feasible one, the
+    /// lowest `J` among the points whose `v` is within the mission's band
+    /// `h_r − h_a` (m), if it beats the optimum's by more than the
+    /// stopping threshold. The SQP restarted from it moves the other
+    /// depths too (and is kept only if it ends better): a plateau left by
+    /// one depth alone may need its neighbours to follow.
     fn sqp_plateau_jump(
         &self,
         obj: &mut PlanObjective<'_, N>,
         bounds: &Bounds<K>,
         j: usize,
         tol: f32,
-    ) -> Option<[f32; K]> {
+    ) -> Option<(f32, [f32; K])> {
         let (&lo, &hi) = bounds.lo.get(j).zip(bounds.hi.get(j))?;
         let out = &self.work;
         if lo >= hi || out.gradient.get(j).is_none_or(|&g| g != 0.0) {
             return None;
         }
+        let m = obj.sc.mission();
+        let band = m.reference_altitude() - m.min_altitude();
+        let v_now = obj.last_violation;
+        let restoring = v_now > tol;
         let threshold = out.j - self.cfg.bfgs.tol.j_threshold(out.j);
         // The tracks before `j` fly the same whatever `z_j`: once.
         let (head, at_j) = obj.head(&out.z, j).ok()?;
+        // Within the reach from where track `j` starts (beyond, the same
+        // plateau).
+        let t = obj.track.saturating_add(j);
+        let (lo, hi) = reach_from(&obj.sc, t, at_j.depth(), (lo, hi));
         let mut best: Option<(f32, [f32; K])> = None;
         for k in 0..self.cfg.scan_points {
             let mut z = out.z;
             if let Some(zj) = z.get_mut(j) {
                 *zj = grid(lo, hi, k, self.cfg.scan_points);
             }
-            if let Ok((jz, v)) = obj.tail_value(&head, (&at_j, j), &z)
-                && v <= tol
-                && jz < best.as_ref().map_or(threshold, |b| b.0)
-            {
-                best = Some((jz, z));
+            let Ok((jz, v)) = obj.tail_value(&head, (&at_j, j), &z) else {
+                continue;
+            };
+            let (score, bar) = if restoring {
+                (v, v_now - tol)
+            } else if v <= band {
+                (jz, threshold)
+            } else {
+                continue;
+            };
+            if score < best.as_ref().map_or(bar, |b| b.0) {
+                best = Some((score, z));
             }
         }
-        best.map(|b| b.1)
+        best
     }
 
     /// Further penalty stages: each re-solves from the last optimum with
