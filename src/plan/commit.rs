@@ -22,48 +22,35 @@
 //! beyond it is promised.
 
 use crate::model::ProfileView;
-use crate::optim::root::{self, RootTol};
-use crate::sim::{Scenario, VehicleState, World};
+use crate::sim::{Scenario, TrackScore, VehicleState, World};
 
 use super::candidate::Candidate;
-use super::certify::{Certificate, Tube, vehicle_margin};
+use super::certify::{ALL, Certificate, Tube, vehicle_margin};
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
 
-/// The certified-altitude tolerance of the continuation search, m (as the
-/// single track's boundary search: 0.2 % of `h_r − h_a`, 1 mm to 2 cm).
-const SEARCH_SHARE: f32 = 0.002;
-
-/// The search stops when the step along the path is this short (of 1).
-const SEARCH_WIDTH: f32 = 1e-3;
-
-/// Most rounds of the continuation search (a round: a root search in the
-/// critical worlds, then the point found certified in every world).
-const SEARCH_ROUNDS: u32 = 4;
-
-/// The search path's ends: the certified anchor and the candidate, each
-/// with its certificate.
-type Ends<'c, const N: usize> = (
-    (&'c [f32; MAX_TRACKS], Certificate),
-    (&'c [f32; MAX_TRACKS], Certificate),
-);
-
-/// A search bracket: the safe end and the unsafe one, each a point on the
-/// path (of 1) with its certified margin over `h_safe`, m.
-type Bracket = ((f32, f32), (f32, f32));
-
 /// A continuation with its certificate.
 #[derive(Clone, Copy, Debug)]
-struct Chosen<const N: usize> {
-    depths: [f32; MAX_TRACKS],
-    len: usize,
-    cert: Certificate,
+pub(super) struct Chosen<const N: usize> {
+    pub(super) depths: [f32; MAX_TRACKS],
+    pub(super) len: usize,
+    pub(super) cert: Certificate,
     /// Whether it was found on the search path (not the candidate itself).
-    searched: bool,
+    pub(super) searched: bool,
+    /// Whether it is the previous call's continuation, its certificate
+    /// known (the candidate was no better).
+    pub(super) previous: bool,
 }
+
+/// A later call keeps the previous continuation, whose certificate it
+/// knows, unless the candidate lowers the line's `J` (the tracks committed
+/// so far and the horizon) by more than this share: re-certifying costs a
+/// flight per declared world, and the candidate differs from the kept
+/// continuation mostly by what the gaps measured anew moved.
+const KEEP_SHARE: f32 = 1e-3;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// Commits the call's depth: certifies it (with its continuation in
@@ -81,56 +68,142 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             World::corners(sc.vehicle(), u),
             vehicle_margin(sc.vehicle(), u),
         );
-        self.tube.prepare(worlds, state, track);
+        let kept = self.tube.prepare(worlds, state, track);
+        if !kept {
+            self.line_j = 0.0;
+        }
         let mut flights = cand.evaluations;
         let guaranteed = self.cfg.mode == Mode::Horizon && self.cfg.constrained;
-        let chosen = if guaranteed {
-            let c = self.continue_safely(sc, bottom, (state, track), &cand, &mut flights)?;
-            self.completed(sc, bottom, c, &mut flights)
-        } else {
-            let mut depths = [0.0; MAX_TRACKS];
-            depths[0] = cand.flown.depth;
-            let at = (f32::NEG_INFINITY, &mut flights);
-            let cert = self.certify_one(sc, bottom, (state, &cand.flown), at);
-            Chosen {
-                depths,
-                len: 1,
-                cert,
-                searched: false,
-            }
-        };
+        // Unbudgeted, the worlds' advance is flown only when a certificate
+        // needs it (the budget accounts for it at every call).
+        let lazy = self.budget.limit == u32::MAX;
+        let how = (guaranteed, kept && lazy);
+        let chosen = self.choose(sc, bottom, (state, track), (&cand, how), &mut flights)?;
         let depth = chosen.depths[0];
-        let flown = if depth.to_bits() == cand.flown.depth.to_bits() {
-            cand.flown
+        let flown = fly_committed(sc, (state, track), depth, cand.flown, &mut flights)?;
+        let minima = if chosen.previous {
+            self.cont.minima
         } else {
-            let mut fl = Flights {
-                sc: *sc,
-                state,
-                track,
-                count: flights,
-                limit: u32::MAX,
-            };
-            let (score, next) = fl.fly(depth)?;
-            flights = fl.count;
-            Flown { depth, score, next }
+            self.tube.minima_of(&chosen.cert)
         };
         self.keep(&chosen, track, guaranteed);
+        self.cont.minima = minima.filter(|_| guaranteed).map(|m| {
+            // (The tracks after the committed one.)
+            core::array::from_fn(|i| {
+                m.get(i.saturating_add(1))
+                    .copied()
+                    .unwrap_or(f32::NEG_INFINITY)
+            })
+        });
         let only_nominal = nominal_only(sc, bottom, &self.tube, state);
         self.tube.advance(
             (sc, bottom),
             depth,
             &flown.next,
-            (only_nominal, &mut flights),
+            (only_nominal, lazy, &mut flights),
         );
         let safe = chosen.cert.all >= cand.h_safe;
+        self.line_j += flown.score.j();
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
         let status = self.status(sc, &cand, &chosen, safe);
         Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
     }
 
+    /// The continuation to commit and its certificate: the known one
+    /// ([`Planner::known_continuation`]) when `known` allows it, else
+    /// ([`Planner::continue_safely`]) with `guaranteed`, else the
+    /// candidate's track alone.
+    fn choose(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (state, track): (&VehicleState<N>, usize),
+        (cand, (guaranteed, known)): (&Candidate<N>, (bool, bool)),
+        flights: &mut u32,
+    ) -> Result<Chosen<N>, PlanError> {
+        let kept = (guaranteed && known)
+            .then(|| self.known_continuation(sc, bottom, (state, track), cand, flights))
+            .flatten();
+        if let Some(c) = kept {
+            return Ok(c);
+        }
+        self.tube
+            .materialize((sc, bottom), (state, track), (ALL, &mut *flights));
+        if guaranteed {
+            let c = self.continue_safely(sc, bottom, (state, track), cand, flights)?;
+            return Ok(self.completed(sc, bottom, c, flights));
+        }
+        let mut depths = [0.0; MAX_TRACKS];
+        depths[0] = cand.flown.depth;
+        let at = (f32::NEG_INFINITY, flights);
+        Ok(Chosen {
+            depths,
+            len: 1,
+            cert: self.certify_one(sc, bottom, (state, &cand.flown), at),
+            searched: false,
+            previous: false,
+        })
+    }
+
+    /// The previous call's continuation with its certificate, known
+    /// without a flight when the worlds start where that call predicted
+    /// (the certificate's flights pass through these very states), when
+    /// the certificate is more than the nominal flight, and when the
+    /// candidate is no better than it on the horizon by more than
+    /// [`KEEP_SHARE`] of `Σ J` (the optimizer started from it, so its start
+    /// value is the continuation's).
+    fn known_continuation(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (state, track): (&VehicleState<N>, usize),
+        cand: &Candidate<N>,
+        flights: &mut u32,
+    ) -> Option<Chosen<N>> {
+        if nominal_only(sc, bottom, &self.tube, state) {
+            return None;
+        }
+        let (certified, minima) = (self.cont.certified?, self.cont.minima?);
+        let len = sc.waypoints().tracks().saturating_sub(track);
+        let shallow = sc.mission().depth_limits()[0];
+        let depths = self.previous_continuation(track, len, shallow)?;
+        // Its horizon's `Σ J`: known when the optimizer started from it,
+        // else one nominal flight.
+        let prev_j = match cand.previous_j {
+            Some(j) => j,
+            None => {
+                let h = self.horizon_len.max(1).min(len);
+                let mut scores = [TrackScore::default(); MAX_TRACKS];
+                *flights = flights.saturating_add(1);
+                let d = depths.get(..h)?;
+                sc.fly(state, track, d, scores.get_mut(..h)?).ok()?;
+                scores.iter().take(h).map(TrackScore::j).sum()
+            }
+        };
+        let line = libm::fabsf(self.line_j) + libm::fabsf(prev_j);
+        let better = self.work.j < prev_j - KEEP_SHARE * line;
+        if better || certified.partial || len == 0 {
+            return None;
+        }
+        let m = minima.get(..len)?;
+        let cert = Certificate {
+            first: m.first().copied()?,
+            all: m.iter().copied().fold(f32::INFINITY, f32::min),
+            partial: false,
+            id: 0,
+        };
+        (cert.all >= cand.h_safe).then_some(Chosen {
+            depths,
+            len,
+            cert,
+            searched: false,
+            previous: true,
+        })
+    }
+
     /// The continuation to commit (module docs): the candidate if it
     /// certifies, else the last certified point on the path from an
-    /// anchor, else the safest tried.
+    /// anchor ([`super::search`]), else the safest tried.
     fn continue_safely(
         &self,
         sc: &Scenario<'_, N>,
@@ -151,6 +224,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             len,
             cert: cert_c,
             searched: false,
+            previous: false,
         };
         if cert_c.all >= cand.h_safe {
             return Ok(candidate);
@@ -158,24 +232,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The candidate's depth, then the climb: the optimized later depths
         // may lead into a trap that the next call's horizon would see and
         // avoid, while the committed depth alone need not.
-        let mut c2 = [shallow; MAX_TRACKS];
-        c2[0] = cand.flown.depth;
-        // (The same line as the candidate when its tail is the climb
-        // already: its certificate is at hand.)
-        let same = c2.iter().zip(&c).all(|(a, b)| a.to_bits() == b.to_bits());
-        let cert_c2 = if same {
-            cert_c
-        } else {
-            let spare = self.budget.anchor;
-            let at = (cand.h_safe, &mut *flights);
-            self.certify_within(sc, bottom, c2.get(..len).unwrap_or(&[]), at, spare)
-        };
+        let (c2, cert_c2) = self.then_climb(sc, bottom, cand, ((&c, cert_c), len), flights);
         if cert_c2.all >= cand.h_safe {
             return Ok(Chosen {
                 depths: c2,
                 len,
                 cert: cert_c2,
                 searched: false,
+                previous: false,
             });
         }
         let (c, cert_c) = if cert_c2.all > cert_c.all {
@@ -205,10 +269,34 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                     len,
                     cert: cert_a,
                     searched: true,
+                    previous: false,
                 };
             }
         }
         Ok(best)
+    }
+
+    /// The candidate's depth, then the shallowest allowed depth on every
+    /// later track, with its certificate (the candidate's when that is
+    /// the same line).
+    fn then_climb(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        cand: &Candidate<N>,
+        ((c, cert_c), len): ((&[f32; MAX_TRACKS], Certificate), usize),
+        flights: &mut u32,
+    ) -> ([f32; MAX_TRACKS], Certificate) {
+        let shallow = sc.mission().depth_limits()[0];
+        let mut c2 = [shallow; MAX_TRACKS];
+        c2[0] = cand.flown.depth;
+        if c2.iter().zip(c).all(|(a, b)| a.to_bits() == b.to_bits()) {
+            return (c2, cert_c);
+        }
+        let spare = self.budget.anchor;
+        let at = (cand.h_safe, flights);
+        let cert = self.certify_within(sc, bottom, c2.get(..len).unwrap_or(&[]), at, spare);
+        (c2, cert)
     }
 
     /// `chosen` with its certificate complete: a partial one (some worlds
@@ -269,7 +357,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// The candidate continuation: the call's depth, its optimized
     /// horizon, then the previous continuation beyond it (or the climb to
     /// `shallow`, m).
-    fn candidate_continuation(
+    pub(super) fn candidate_continuation(
         &self,
         track: usize,
         len: usize,
@@ -286,103 +374,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             };
         }
         c
-    }
-
-    /// The last certified point on the path `a + t (c − a)`, `t ∈ [0, 1]`,
-    /// from the certified anchor `a` towards the candidate `c`.
-    ///
-    /// The root search flies only the *critical* worlds (those that have
-    /// set a certificate's least altitude, [`Tube::critical`]): their
-    /// least altitude bounds the certificate from above, so a point they
-    /// reject is rejected. The point found is then certified in every
-    /// world; if another world rejects it, that world becomes critical, the
-    /// point becomes the bracket's unsafe end and the search goes on (at
-    /// most [`SEARCH_ROUNDS`] rounds, then the last certified point).
-    fn search(
-        &self,
-        sc: &Scenario<'_, N>,
-        bottom: ProfileView<'_>,
-        ((a, cert_a), (c, cert_c)): Ends<'_, N>,
-        len: usize,
-        h_safe: f32,
-        flights: &mut u32,
-    ) -> Chosen<N> {
-        let at = |t: f32| -> [f32; MAX_TRACKS] {
-            core::array::from_fn(|i| {
-                let (ai, ci) = (
-                    a.get(i).copied().unwrap_or(0.0),
-                    c.get(i).copied().unwrap_or(0.0),
-                );
-                ai + t * (ci - ai)
-            })
-        };
-        let m = sc.mission();
-        let rule = RootTol {
-            tol: (SEARCH_SHARE * (m.reference_altitude() - m.min_altitude())).clamp(1e-3, 0.02),
-            width: SEARCH_WIDTH,
-            steps: self.cfg.bisection_steps,
-        };
-        let mut good = (0.0, cert_a);
-        let mut bad = (1.0, cert_c.all - h_safe);
-        for _ in 0..SEARCH_ROUNDS {
-            let ends = ((good.0, good.1.all - h_safe), bad);
-            let ends = (ends, h_safe);
-            let Some((t, screened)) =
-                self.screened_root(sc, bottom, (&at, len), ends, rule, flights)
-            else {
-                break;
-            };
-            // (Every world flown already when all are critical.)
-            let cert = if screened.partial {
-                if !self.budget.afford(*flights) {
-                    break;
-                }
-                let d = at(t);
-                let d = d.get(..len).unwrap_or(&[]);
-                self.tube.certify(sc, bottom, d, (h_safe, &mut *flights))
-            } else {
-                screened
-            };
-            if cert.all >= h_safe {
-                good = (t, cert);
-                break;
-            }
-            bad = (t, cert.all - h_safe);
-        }
-        Chosen {
-            depths: if good.0 > 0.0 { at(good.0) } else { *a },
-            len,
-            cert: good.1,
-            searched: true,
-        }
-    }
-
-    /// One round of [`Planner::search`]: the boundary of the critical
-    /// worlds' certificate between `good` and `bad` (`t` with its margin
-    /// over `h_safe`, m) with that certificate, or `None` where it did not
-    /// move off `good`.
-    fn screened_root<F: Fn(f32) -> [f32; MAX_TRACKS]>(
-        &self,
-        sc: &Scenario<'_, N>,
-        bottom: ProfileView<'_>,
-        (at, len): (&F, usize),
-        ((good, bad), h_safe): (Bracket, f32),
-        rule: RootTol,
-        flights: &mut u32,
-    ) -> Option<(f32, Certificate)> {
-        let budget = self.budget;
-        let mask = self.tube.critical();
-        let r = root::safe_boundary((good.0, Some(good.1)), (bad.0, Some(bad.1)), rule, |t| {
-            if !budget.afford(*flights) {
-                return Err(());
-            }
-            let d = at(t);
-            let d = d.get(..len).unwrap_or(&[]);
-            let cert = self.tube.certify_only(sc, bottom, d, mask, flights);
-            Ok::<_, ()>((cert.all - h_safe, cert))
-        });
-        let root = r.ok()?;
-        root.at.filter(|_| root.z > good.0).map(|c| (root.z, c))
     }
 
     /// The certificate of the candidate's track alone: its nominal flight
@@ -423,7 +414,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if let Some(first) = self.work.z.first_mut() {
             *first = chosen.depths[0];
         }
-        if chosen.searched
+        if (chosen.searched || chosen.previous)
             && let Some(w) = self.warm.as_mut()
         {
             for (dst, src) in w
@@ -500,6 +491,30 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         );
         plan
     }
+}
+
+/// The committed depth's flight: the candidate's when the depth is its,
+/// else flown (one more flight in `flights`).
+fn fly_committed<const N: usize>(
+    sc: &Scenario<'_, N>,
+    (state, track): (&VehicleState<N>, usize),
+    depth: f32,
+    candidate: Flown<N>,
+    flights: &mut u32,
+) -> Result<Flown<N>, PlanError> {
+    if depth.to_bits() == candidate.depth.to_bits() {
+        return Ok(candidate);
+    }
+    let mut fl = Flights {
+        sc: *sc,
+        state,
+        track,
+        count: *flights,
+        limit: u32::MAX,
+    };
+    let (score, next) = fl.fly(depth)?;
+    *flights = fl.count;
+    Ok(Flown { depth, score, next })
 }
 
 /// Whether the only world is the nominal one over the map, from `state`:

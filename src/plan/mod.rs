@@ -112,6 +112,7 @@
 //! | `resumable.rs` | [`Resumable`]: one call as bounded steps |
 //! | `candidate.rs` | one call's candidate, step by step |
 //! | `commit.rs` | what is committed: the certified continuation (§11) |
+//! | `gaps.rs` | the SQP's targets raised by the certification gap (§12) |
 //! | `certify.rs` | certificates over the declared worlds (§12), [`certify_line`] |
 //! | `flights.rs` | the call's plain flights, counted |
 //! | `solve.rs` | the optimizer runs: the SQP (BFGS), penalty stages (GD), plateau escape |
@@ -128,10 +129,12 @@ mod commit;
 mod config;
 mod fallback;
 mod flights;
+mod gaps;
 mod objective;
 mod planner;
 mod resumable;
 mod scan;
+mod search;
 mod single;
 mod solve;
 mod status;

@@ -7,6 +7,8 @@ use crate::optim::Objective;
 use crate::optim::sqp::{Constrained, Linearized};
 use crate::sim::{Scenario, SimError, TrackScore, VehicleState, Watch};
 
+use super::certify::MAX_TRACKS;
+
 /// Why [`PlanObjective`] did not return a value: the flight failed, the
 /// budget is spent, or (a constrained single track) the optimizer has left
 /// the safe set and the boundary search takes over. An explicit stop, not an error
@@ -57,6 +59,10 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     /// Segments further above the target than this (m) stay out of the
     /// SQP's step.
     pub band: f32,
+    /// Raises of each track's target (m, the horizon's tracks in order):
+    /// the gap between its nominal and its certified least altitude
+    /// (`gaps.rs`).
+    pub gaps: [f32; MAX_TRACKS],
 }
 
 impl<'a, const N: usize> PlanObjective<'a, N> {
@@ -84,6 +90,7 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             best_safe: None,
             target: (f32::NEG_INFINITY, f32::NEG_INFINITY),
             band: f32::INFINITY,
+            gaps: [0.0; MAX_TRACKS],
         }
     }
 }
@@ -107,7 +114,8 @@ impl<const N: usize> PlanObjective<'_, N> {
 
     /// The SQP's target altitude of track `t` of the horizon, m.
     fn target_of(&self, t: usize) -> f32 {
-        if t == 0 { self.target.0 } else { self.target.1 }
+        let base = if t == 0 { self.target.0 } else { self.target.1 };
+        base + self.gaps.get(t).copied().unwrap_or(0.0)
     }
 
     /// The ℓ1 infeasibility of `scores` for the SQP: the sum over the
@@ -266,9 +274,8 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
             .map_err(Stop::Sim)?;
         out.rows = rows;
         // Each segment's least altitude above its track's target.
-        let targets = (self.target.0, self.target.1);
         for (c, &t) in out.c.iter_mut().zip(out.group.iter()).take(rows) {
-            *c -= if t == 0 { targets.0 } else { targets.1 };
+            *c -= self.target_of(usize::from(t));
         }
         out.j = e.j;
         out.grad = e.grad_j;

@@ -9,9 +9,7 @@ use super::budget::Budget;
 use super::certify::{Certificate, Tube};
 use super::{Plan, PlanError, PlannerConfig};
 
-/// Most tracks a line may have in horizon mode: the continuation that a
-/// committed depth's safety rests on covers every later track.
-pub const MAX_TRACKS: usize = 64;
+pub use super::certify::MAX_TRACKS;
 
 /// A receding-horizon or track-wise planner of up to `K` tracks at a time,
 /// for a plant of order at most `N` (default 3).
@@ -39,6 +37,11 @@ pub struct Planner<const K: usize, const N: usize = 3> {
     pub(super) tube: Tube<N>,
     /// The current call's flight budget (`budget.rs`).
     pub(super) budget: Budget,
+    /// Each track's certification gap, m (`gaps.rs`).
+    pub(super) gaps: [f32; MAX_TRACKS],
+    /// `J` of the tracks committed since the worlds last started afresh,
+    /// m³: the scale a later call's gain is weighed on (`commit.rs`).
+    pub(super) line_j: f32,
 }
 
 #[cfg(feature = "defmt")]
@@ -76,6 +79,11 @@ pub(super) struct Continuation {
     /// The certificate it was committed with (with the depth before it),
     /// when that was safe in horizon mode.
     pub certified: Option<Certificate>,
+    /// That certificate's least altitude on each track of the
+    /// continuation (from `track`), m, when it flew every world: the next
+    /// call, starting where this one predicted, knows the continuation's
+    /// certificate without flying it.
+    pub minima: Option<[f32; MAX_TRACKS]>,
 }
 
 impl Continuation {
@@ -85,6 +93,7 @@ impl Continuation {
         depths: [0.0; MAX_TRACKS],
         len: 0,
         certified: None,
+        minima: None,
     };
 
     /// The depth for track `t`, if covered.
@@ -110,6 +119,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             cont: Continuation::NONE,
             tube: Tube::default(),
             budget: Budget::NONE,
+            gaps: [0.0; MAX_TRACKS],
+            line_j: 0.0,
         })
     }
 
@@ -124,6 +135,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.warm = None;
         self.cont = Continuation::NONE;
         self.tube.reset();
+        self.gaps = [0.0; MAX_TRACKS];
     }
 
     /// The last call's optimized horizon, m: the candidate depth of the

@@ -97,7 +97,28 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         skip: u64,
     ) -> Result<(u32, u64), PlanError> {
-        self.work.history.clear();
+        // (A run after the call's first continues its history: its start
+        // counts as one more iteration, as a plateau's restart does.)
+        let chained = !self.work.history.is_empty();
+        let before = if chained {
+            self.work.iterations.saturating_add(1)
+        } else {
+            0
+        };
+        let out = self.solve_sqp_run(obj, z0, (h, bounds), tol, skip)?;
+        self.work.iterations = before.saturating_add(out.0);
+        Ok((self.work.iterations, out.1))
+    }
+
+    /// [`Planner::solve_sqp`]'s run, its iterations counted from 0.
+    fn solve_sqp_run(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        z0: &[f32; K],
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        skip: u64,
+    ) -> Result<(u32, u64), PlanError> {
         let mut metric = None;
         let run = sqp_into(
             obj,
@@ -126,9 +147,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                     .ok()
                     .and_then(|j| 1_u64.checked_shl(j))
                     .unwrap_or(0);
-                // (The committed track's plateau is scanned again: it now
-                // has the first track's target.)
-                if (skip | scanned) & bit != 0 && j > 0 {
+                if (skip | scanned) & bit != 0 {
                     continue;
                 }
                 if self.work.gradient.get(j).is_some_and(|&g| g == 0.0) {

@@ -100,8 +100,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 first: c.all,
                 all: c.all,
                 partial: false,
+                id: 0,
             });
-        let tail = if nominal { 1 } else { w.saturating_add(1) };
+        // (A tube that owes its worlds' advance, from unbudgeted calls
+        // before: one more flight per world, before any certificate.)
+        let owed = if self.tube.owes() { w } else { 0 };
+        let tail = if nominal { 1 } else { w.saturating_add(1) }.saturating_add(owed);
         let certify = if nominal && (len == 1 || !guaranteed) {
             0
         } else {
@@ -254,6 +258,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             evaluations: fl.count,
             h_safe,
             cert,
+            previous_j: None,
         })
     }
 
@@ -332,6 +337,7 @@ fn fly_line<const N: usize>(
         first: f.score.min_altitude(),
         all,
         partial: false,
+        id: 0,
     };
     Ok((f, cert))
 }

@@ -85,7 +85,7 @@
 #define AUVNAV_ERR_SIMULATION -16
 
 // Bytes of an `auvnav_planner`.
-#define AUVNAV_PLANNER_SIZE 40960
+#define AUVNAV_PLANNER_SIZE 45056
 
 // Bytes of an `auvnav_autopilot`.
 #define AUVNAV_AUTOPILOT_SIZE 128

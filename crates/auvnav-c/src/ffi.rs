@@ -19,7 +19,7 @@ use crate::planner::PlannerInner;
 use crate::types::*;
 
 /// Bytes of an `auvnav_planner`.
-pub const AUVNAV_PLANNER_SIZE: usize = 40960;
+pub const AUVNAV_PLANNER_SIZE: usize = 45056;
 /// Bytes of an `auvnav_autopilot`.
 pub const AUVNAV_AUTOPILOT_SIZE: usize = 128;
 /// Alignment of both opaque objects, bytes.

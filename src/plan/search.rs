@@ -1,0 +1,134 @@
+//! The continuation search: the last certified point on the straight
+//! path from a certified anchor towards the candidate continuation
+//! ([`super::commit`] calls it when the candidate does not certify).
+
+use crate::model::ProfileView;
+use crate::optim::root::{self, RootTol};
+use crate::sim::Scenario;
+
+use super::Planner;
+use super::certify::Certificate;
+use super::commit::Chosen;
+use super::planner::MAX_TRACKS;
+
+/// The certified-altitude tolerance of the continuation search, m (as the
+/// single track's boundary search: 0.2 % of `h_r − h_a`, 1 mm to 2 cm).
+const SEARCH_SHARE: f32 = 0.002;
+
+/// The search stops when the step along the path is this short (of 1).
+const SEARCH_WIDTH: f32 = 1e-3;
+
+/// Most rounds of the continuation search (a round: a root search in the
+/// critical worlds, then the point found certified in every world).
+const SEARCH_ROUNDS: u32 = 4;
+
+/// The search path's ends: the certified anchor and the candidate, each
+/// with its certificate.
+type Ends<'c, const N: usize> = (
+    (&'c [f32; MAX_TRACKS], Certificate),
+    (&'c [f32; MAX_TRACKS], Certificate),
+);
+
+/// A search bracket: the safe end and the unsafe one, each a point on the
+/// path (of 1) with its certified margin over `h_safe`, m.
+type Bracket = ((f32, f32), (f32, f32));
+
+impl<const K: usize, const N: usize> Planner<K, N> {
+    /// The last certified point on the path `a + t (c − a)`, `t ∈ [0, 1]`,
+    /// from the certified anchor `a` towards the candidate `c`.
+    ///
+    /// The root search flies only the *critical* worlds (those that have
+    /// set a certificate's least altitude, [`Tube::critical`]): their
+    /// least altitude bounds the certificate from above, so a point they
+    /// reject is rejected. The point found is then certified in every
+    /// world; if another world rejects it, that world becomes critical, the
+    /// point becomes the bracket's unsafe end and the search goes on (at
+    /// most [`SEARCH_ROUNDS`] rounds, then the last certified point).
+    pub(super) fn search(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        ((a, cert_a), (c, cert_c)): Ends<'_, N>,
+        len: usize,
+        h_safe: f32,
+        flights: &mut u32,
+    ) -> Chosen<N> {
+        let at = |t: f32| -> [f32; MAX_TRACKS] {
+            core::array::from_fn(|i| {
+                let (ai, ci) = (
+                    a.get(i).copied().unwrap_or(0.0),
+                    c.get(i).copied().unwrap_or(0.0),
+                );
+                ai + t * (ci - ai)
+            })
+        };
+        let m = sc.mission();
+        let rule = RootTol {
+            tol: (SEARCH_SHARE * (m.reference_altitude() - m.min_altitude())).clamp(1e-3, 0.02),
+            width: SEARCH_WIDTH,
+            steps: self.cfg.bisection_steps,
+        };
+        let mut good = (0.0, cert_a);
+        let mut bad = (1.0, cert_c.all - h_safe);
+        for _ in 0..SEARCH_ROUNDS {
+            let ends = ((good.0, good.1.all - h_safe), bad);
+            let ends = (ends, h_safe);
+            let Some((t, screened)) =
+                self.screened_root(sc, bottom, (&at, len), ends, rule, flights)
+            else {
+                break;
+            };
+            // (Every world flown already when all are critical.)
+            let cert = if screened.partial {
+                if !self.budget.afford(*flights) {
+                    break;
+                }
+                let d = at(t);
+                let d = d.get(..len).unwrap_or(&[]);
+                self.tube.certify(sc, bottom, d, (h_safe, &mut *flights))
+            } else {
+                screened
+            };
+            if cert.all >= h_safe {
+                good = (t, cert);
+                break;
+            }
+            bad = (t, cert.all - h_safe);
+        }
+        Chosen {
+            depths: if good.0 > 0.0 { at(good.0) } else { *a },
+            len,
+            cert: good.1,
+            searched: true,
+            previous: false,
+        }
+    }
+
+    /// One round of [`Planner::search`]: the boundary of the critical
+    /// worlds' certificate between `good` and `bad` (`t` with its margin
+    /// over `h_safe`, m) with that certificate, or `None` where it did not
+    /// move off `good`.
+    fn screened_root<F: Fn(f32) -> [f32; MAX_TRACKS]>(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (at, len): (&F, usize),
+        ((good, bad), h_safe): (Bracket, f32),
+        rule: RootTol,
+        flights: &mut u32,
+    ) -> Option<(f32, Certificate)> {
+        let budget = self.budget;
+        let mask = self.tube.critical();
+        let r = root::safe_boundary((good.0, Some(good.1)), (bad.0, Some(bad.1)), rule, |t| {
+            if !budget.afford(*flights) {
+                return Err(());
+            }
+            let d = at(t);
+            let d = d.get(..len).unwrap_or(&[]);
+            let cert = self.tube.certify_only(sc, bottom, d, mask, flights);
+            Ok::<_, ()>((cert.all - h_safe, cert))
+        });
+        let root = r.ok()?;
+        root.at.filter(|_| root.z > good.0).map(|c| (root.z, c))
+    }
+}
