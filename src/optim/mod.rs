@@ -280,6 +280,20 @@ impl<const K: usize> Outcome<K> {
             history: Vec::new(),
         }
     }
+
+    /// This outcome made [`Outcome::at`] `z` in place (no temporary of
+    /// the history's size on the stack).
+    pub(crate) fn reset_at(&mut self, z: &[f32; K]) {
+        self.z = *z;
+        self.j = f32::INFINITY;
+        self.gradient = [0.0; K];
+        self.grad_norm = 0.0;
+        self.status = Status::Converged;
+        self.iterations = 0;
+        self.evaluations = 0;
+        self.skipped_updates = 0;
+        self.history.clear();
+    }
 }
 
 /// An optimizer setting out of range.

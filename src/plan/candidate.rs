@@ -5,6 +5,8 @@
 //! penalized solve with its plateau escape, verification and fallback.
 //! What is committed, and how safe it is, is `commit.rs`'s.
 
+use core::cell::Cell;
+
 use crate::optim::Bounds;
 use crate::sim::{Scenario, TrackScore, VehicleState};
 
@@ -180,7 +182,17 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<Candidate<N>, PlanError> {
         let m = sc.mission();
         let tol = boundary_tolerance(m.reference_altitude() - m.min_altitude());
+        // Under declared uncertainty, unbudgeted: the targets raised by the
+        // certification gaps (the last calls' first, `gaps.rs`).
+        let certifying = self.cfg.constrained && self.budget.limit == u32::MAX;
+        let mut gaps = [0.0_f32; K];
+        if certifying {
+            for (dst, src) in gaps.iter_mut().zip(self.gaps.iter().skip(fl.track)) {
+                *dst = *src;
+            }
+        }
         let mut obj = PlanObjective::new(penalized, fl.state, fl.track, s.h, 0.0);
+        obj.gaps = Cell::from_mut(&mut gaps[..]).as_slice_of_cells();
         obj.budget = self.budget.optimizer(fl.count)?;
         if self.cfg.constrained {
             // The later tracks keep a share of the penalty margin: the next
@@ -206,14 +218,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let (z, c) = (start.get(i), self.cont.depth(fl.track.saturating_add(i)));
             z.zip(c).is_some_and(|(a, b)| a.to_bits() == b.to_bits())
         });
-        // Under declared uncertainty, unbudgeted: the targets raised by the
-        // certification gaps (the last calls' first, `gaps.rs`).
-        let certifying = self.cfg.constrained && self.budget.limit == u32::MAX;
-        if certifying {
-            for (dst, src) in obj.gaps.iter_mut().zip(self.gaps.iter().skip(fl.track)) {
-                *dst = *src;
-            }
-        }
         if certifying {
             self.seed_gaps(sc, &mut obj, (z0, s.h), tol)?;
         }

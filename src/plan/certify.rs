@@ -192,14 +192,12 @@ impl<const N: usize> Tube<N> {
                 continue;
             }
             *flights = flights.saturating_add(1);
-            let mut scores = [TrackScore::default(); MAX_TRACKS];
             let rest = self.pending.get(from..).unwrap_or(&[]);
             let at = self.track.saturating_add(from);
-            let flown = match (sc.in_world(w, bottom), scores.get_mut(..rest.len())) {
-                (Ok(scw), Some(s)) => scw.fly(st, at, rest, s),
-                _ => Err(SimError::ScoreBuffer),
-            };
-            match flown {
+            match sc
+                .in_world(w, bottom)
+                .and_then(|scw| fly_on(&scw, st, at, rest))
+            {
                 Ok(next) => {
                     *st = next;
                     *done = u8::try_from(n).unwrap_or(u8::MAX);
@@ -469,6 +467,28 @@ impl<const N: usize> Tube<N> {
         }
         set
     }
+}
+
+/// Tracks flown per call by [`fly_on`] (its score buffer's length).
+const FLY_CHUNK: usize = 4;
+
+/// The state after flying `depths` from `st` on `track`, a few tracks per
+/// flight call (the scores are not needed, so the buffer stays small;
+/// the state is the same as one call's, step for step).
+fn fly_on<const N: usize>(
+    sc: &Scenario<'_, N>,
+    st: &VehicleState<N>,
+    track: usize,
+    depths: &[f32],
+) -> Result<VehicleState<N>, SimError> {
+    let mut scores = [TrackScore::default(); FLY_CHUNK];
+    let mut state = *st;
+    for (c, chunk) in depths.chunks(FLY_CHUNK).enumerate() {
+        let at = track.saturating_add(c.saturating_mul(FLY_CHUNK));
+        let s = scores.get_mut(..chunk.len()).ok_or(SimError::ScoreBuffer)?;
+        state = sc.fly(&state, at, chunk, s)?;
+    }
+    Ok(state)
 }
 
 /// One world's flight of `depths` from `st` on `track`: the least altitude

@@ -63,12 +63,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         cand: Candidate<N>,
     ) -> Result<Plan<N>, PlanError> {
         let bottom = certification_bottom(sc)?;
-        let u = sc.mission().uncertainty();
-        let worlds = (
-            World::corners(sc.vehicle(), u),
-            vehicle_margin(sc.vehicle(), u),
-        );
-        let kept = self.tube.prepare(worlds, state, track);
+        let kept = self.prepare_tube(sc, state, track);
         if !kept {
             self.line_j = 0.0;
         }
@@ -107,6 +102,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
         let status = self.status(sc, &cand, &chosen, safe);
         Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
+    }
+
+    /// The tube's worlds for this call, its states kept when the vehicle
+    /// is where they predicted ([`Tube::prepare`]). Not inlined: the
+    /// declared worlds' list stays off the certifying path's stack.
+    #[inline(never)]
+    fn prepare_tube(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+    ) -> bool {
+        let u = sc.mission().uncertainty();
+        let worlds = (
+            World::corners(sc.vehicle(), u),
+            vehicle_margin(sc.vehicle(), u),
+        );
+        self.tube.prepare(worlds, state, track)
     }
 
     /// The continuation to commit and its certificate: the known one
@@ -151,7 +164,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// the certificate is more than the nominal flight, and when the
     /// candidate is no better than it on the horizon by more than
     /// [`KEEP_SHARE`] of `Σ J` (the optimizer started from it, so its start
-    /// value is the continuation's).
+    /// value is the continuation's). Not inlined: its frame stays off the
+    /// certifying path's stack.
+    #[inline(never)]
     fn known_continuation(
         &self,
         sc: &Scenario<'_, N>,
@@ -172,8 +187,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let prev_j = match cand.previous_j {
             Some(j) => j,
             None => {
-                let h = self.horizon_len.max(1).min(len);
-                let mut scores = [TrackScore::default(); MAX_TRACKS];
+                let h = self.horizon_len.max(1).min(len).min(K);
+                let mut scores = [TrackScore::default(); K];
                 *flights = flights.saturating_add(1);
                 let d = depths.get(..h)?;
                 sc.fly(state, track, d, scores.get_mut(..h)?).ok()?;

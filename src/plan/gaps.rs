@@ -35,7 +35,9 @@ const GAP_ROUNDS: u32 = 3;
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The tube ready for screening: its screening worlds' states at the
     /// call's track (module docs); `None` when the nominal flight over
-    /// the map is the certificate. Counts the flights into `obj`.
+    /// the map is the certificate. Counts the flights into `obj`. Not
+    /// inlined: the declared worlds' list stays off the solve's stack.
+    #[inline(never)]
     fn screening(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -63,13 +65,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// Each horizon track's nominal least altitude over the map and its
     /// least altitude in the screening worlds `mask` over the
     /// certification bottom, less the margin (m, m), for the horizon `z`
-    /// with the continuation beyond it; `None` when a flight fails.
+    /// with the continuation beyond it; `None` when a flight fails. Not
+    /// inlined: the continuation and the worlds' minima stay off the
+    /// stack of the solve that follows.
+    #[inline(never)]
     fn screen_gaps(
         &mut self,
         sc: &Scenario<'_, N>,
         obj: &mut PlanObjective<'_, N>,
         (z, h, mask): (&[f32; K], usize, Worlds),
-    ) -> Result<Option<[(f32, f32); MAX_TRACKS]>, PlanError> {
+    ) -> Result<Option<[(f32, f32); K]>, PlanError> {
         let track = obj.track;
         let bottom = certification_bottom(sc)?;
         let len = sc
@@ -93,7 +98,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let Ok(nominal) = obj.flight(z) else {
             return Ok(None);
         };
-        let mut out = [(f32::INFINITY, f32::INFINITY); MAX_TRACKS];
+        let mut out = [(f32::INFINITY, f32::INFINITY); K];
         for (o, (n, &m)) in out
             .iter_mut()
             .zip(nominal.iter().zip(certified.iter()))
@@ -113,17 +118,17 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         (z0, h): (&[f32; K], usize),
         tol: f32,
     ) -> Result<(), PlanError> {
-        if obj.gaps.iter().take(h).any(|&g| g != 0.0) {
+        if obj.gaps.iter().take(h).any(|g| g.get() != 0.0) {
             return Ok(());
         }
         let Some(mask) = self.screening(sc, obj)? else {
             return Ok(());
         };
         if let Some(pairs) = self.screen_gaps(sc, obj, (z0, h, mask))? {
-            for (slot, (n, m)) in obj.gaps.iter_mut().zip(pairs.iter()).take(h) {
+            for (slot, (n, m)) in obj.gaps.iter().zip(pairs.iter()).take(h) {
                 let gap = n - m;
                 if gap.is_finite() && gap > 0.0 {
-                    *slot = gap + tol;
+                    slot.set(gap + tol);
                 }
             }
         }
@@ -155,11 +160,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let mut raised = false;
             for (t, &(n, m)) in pairs.iter().enumerate().take(h) {
                 let gap = n - m;
-                let Some(slot) = obj.gaps.get_mut(t) else {
+                let Some(slot) = obj.gaps.get(t) else {
                     continue;
                 };
-                if m < h_safe + 0.5 * tol && gap > *slot {
-                    *slot = gap + tol;
+                if m < h_safe + 0.5 * tol && gap > slot.get() {
+                    slot.set(gap + tol);
                     raised = true;
                 }
                 if let Some(keep) = self.gaps.get_mut(track.saturating_add(t)) {

@@ -3,11 +3,11 @@
 //! target altitude; for GD and a single track, `Φ(ζ) = Σ J + μ Σ V`. Both
 //! with their exact gradients from the tangent pass.
 
+use core::cell::Cell;
+
 use crate::optim::Objective;
 use crate::optim::sqp::{Constrained, Linearized};
 use crate::sim::{Scenario, SimError, TrackScore, VehicleState, Watch};
-
-use super::certify::MAX_TRACKS;
 
 /// Why [`PlanObjective`] did not return a value: the flight failed, the
 /// budget is spent, or (a constrained single track) the optimizer has left
@@ -61,8 +61,9 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     pub band: f32,
     /// Raises of each track's target (m, the horizon's tracks in order):
     /// the gap between its nominal and its certified least altitude
-    /// (`gaps.rs`).
-    pub gaps: [f32; MAX_TRACKS],
+    /// (`gaps.rs`). The caller's buffer, one cell per horizon track (none:
+    /// no raise), written between the SQP's runs.
+    pub gaps: &'a [Cell<f32>],
 }
 
 impl<'a, const N: usize> PlanObjective<'a, N> {
@@ -90,7 +91,7 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             best_safe: None,
             target: (f32::NEG_INFINITY, f32::NEG_INFINITY),
             band: f32::INFINITY,
-            gaps: [0.0; MAX_TRACKS],
+            gaps: &[],
         }
     }
 }
@@ -115,7 +116,7 @@ impl<const N: usize> PlanObjective<'_, N> {
     /// The SQP's target altitude of track `t` of the horizon, m.
     fn target_of(&self, t: usize) -> f32 {
         let base = if t == 0 { self.target.0 } else { self.target.1 };
-        base + self.gaps.get(t).copied().unwrap_or(0.0)
+        base + self.gaps.get(t).map_or(0.0, Cell::get)
     }
 
     /// The ℓ1 infeasibility of `scores` for the SQP: the sum over the

@@ -130,7 +130,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         );
         let unstarted = matches!(run, Err(OptimError::Start(Stop::Budget)));
         if unstarted {
-            self.work = crate::optim::Outcome::at(z0);
+            self.work.reset_at(z0);
             return Ok((0, 0));
         }
         run.map_err(start_error)?;
@@ -233,7 +233,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `h_r − h_a` (m), if it beats the optimum's by more than the
     /// stopping threshold. The SQP restarted from it moves the other
     /// depths too (and is kept only if it ends better): a plateau left by
-    /// one depth alone may need its neighbours to follow.
+    /// one depth alone may need its neighbours to follow. Not inlined: the
+    /// scan's state stays off the stack of the SQP runs.
+    #[inline(never)]
     fn sqp_plateau_jump(
         &self,
         obj: &mut PlanObjective<'_, N>,
