@@ -258,38 +258,35 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
         let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
         let half = 0.5 * p.len;
         let (he_lo, he_hi) = (half * p.lo.e, half * p.hi.e);
-        if self.watching {
+        let ends = ((s0, s1), (sq_e, he_lo, he_hi));
+        let n = lin.slot.saturating_add(1);
+        if self.watching && !self.watch.lower_recorded(p.lo.x) {
             let mut de = [(0.0, 0.0); K];
-            for ((j, col), de) in self
-                .cols
-                .iter_mut()
-                .enumerate()
-                .zip(de.iter_mut())
-                .take(lin.slot.saturating_add(1))
-            {
-                *de = col.step_piece(
-                    &self.gains,
-                    &f,
-                    j == lin.slot,
-                    (s0, s1),
-                    (sq_e, he_lo, he_hi),
-                );
+            for ((j, col), de) in self.cols.iter_mut().enumerate().zip(de.iter_mut()).take(n) {
+                *de = col.step_piece(&self.gains, &f, j == lin.slot, ends.0, ends.1);
             }
             self.watch.piece(slot, p, &de);
+            return;
+        }
+        // Watched, the lower end is recorded already: the upper end's
+        // `∂e` is written only when it sets its segment's minimum.
+        let row = if self.watching {
+            self.watch.upper(slot, (p.hi.x, p.hi.e))
         } else {
-            for (j, col) in self
-                .cols
-                .iter_mut()
-                .enumerate()
-                .take(lin.slot.saturating_add(1))
-            {
-                col.step_piece(
-                    &self.gains,
-                    &f,
-                    j == lin.slot,
-                    (s0, s1),
-                    (sq_e, he_lo, he_hi),
-                );
+            None
+        };
+        match row {
+            Some(g) => {
+                for ((j, col), gj) in self.cols.iter_mut().enumerate().zip(g.iter_mut()).take(n) {
+                    *gj = col
+                        .step_piece(&self.gains, &f, j == lin.slot, ends.0, ends.1)
+                        .1;
+                }
+            }
+            None => {
+                for (j, col) in self.cols.iter_mut().enumerate().take(n) {
+                    col.step_piece(&self.gains, &f, j == lin.slot, ends.0, ends.1);
+                }
             }
         }
     }

@@ -52,6 +52,9 @@ pub(crate) struct Watch<'a, const K: usize> {
     h_r: f32,
     /// The Gauss–Newton matrix of `Σ J` (m), when asked for.
     gn: Option<&'a mut [[f32; K]; K]>,
+    /// Where the last piece recorded ended, m (NaN: none yet): a piece
+    /// that starts there has its lower end recorded already.
+    last: f32,
 }
 
 impl<'a, const K: usize> Watch<'a, K> {
@@ -64,6 +67,7 @@ impl<'a, const K: usize> Watch<'a, K> {
             grad: &mut [],
             h_r: 0.0,
             gn: None,
+            last: f32::NAN,
         }
     }
 
@@ -117,6 +121,7 @@ impl<'a, const K: usize> Watch<'a, K> {
             grad,
             h_r,
             gn,
+            last: f32::NAN,
         };
         (watch, next)
     }
@@ -160,9 +165,41 @@ impl<'a, const K: usize> Watch<'a, K> {
         }
     }
 
+    /// Whether a piece starting at `lo` (m) needs only its upper end
+    /// ([`Watch::upper`]): it starts where the last one recorded ended
+    /// (the same sample, so the same altitude, which a strict minimum
+    /// would not take twice), and no Gauss–Newton matrix is asked for.
+    #[inline(always)]
+    pub(super) fn lower_recorded(&self, lo: f32) -> bool {
+        self.gn.is_none() && lo.to_bits() == self.last.to_bits()
+    }
+
+    /// A piece's upper end at `x` with `e` (m) on track `slot`, its lower
+    /// end recorded ([`Watch::lower_recorded`]): when it sets its
+    /// segment's least altitude, the altitude is recorded and the
+    /// segment's gradient row returned, zeroed past `slot`, for the
+    /// caller to fill with `∂e_hi` (columns `j <= slot`).
+    #[inline(always)]
+    pub(super) fn upper(&mut self, slot: usize, (x, e): (f32, f32)) -> Option<&mut [f32; K]> {
+        self.last = x;
+        let s = self.segment(slot, x)?;
+        let h = e + self.h_r;
+        let m = self.min.get_mut(s)?;
+        if h >= *m {
+            return None;
+        }
+        *m = h;
+        let g = self.grad.get_mut(s)?;
+        for gj in g.iter_mut().skip(slot.saturating_add(1)) {
+            *gj = 0.0;
+        }
+        Some(g)
+    }
+
     /// Piece `p` of track `slot`; `de[j] = (∂e_lo, ∂e_hi)` for the
     /// columns `j <= slot`.
     pub(super) fn piece(&mut self, slot: usize, p: &PieceLin, de: &[(f32, f32); K]) {
+        self.last = p.hi.x;
         self.end(slot, (p.lo.x, p.lo.e), de, false);
         self.end(slot, (p.hi.x, p.hi.e), de, true);
         if let Some(gn) = self.gn.as_deref_mut() {
@@ -174,6 +211,84 @@ impl<'a, const K: usize> Watch<'a, K> {
                         *v += half * (da.0 * db.0 + da.1 * db.1);
                     }
                 }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The records of a watched pass: each segment's least altitude is
+    //! its samples' least (flown without tangents, sample by sample), and
+    //! the pass that takes each piece's upper end alone (no Gauss–Newton
+    //! matrix) records exactly what the pass through both ends records.
+    use super::*;
+    use crate::model::{Mission, Profile, Vehicle, Waypoints};
+    use crate::sim::{Scenario, TrackScore};
+
+    const K: usize = 3;
+    const ROWS: usize = 24;
+
+    type Rec = ([f32; ROWS], [[f32; K]; ROWS], [u8; ROWS]);
+
+    fn watched(sc: &Scenario<'_, 3>, z: &[f32; K], gn: bool) -> (Rec, usize) {
+        let (mut min, mut grad, mut track) = ([0.0; ROWS], [[0.0; K]; ROWS], [0; ROWS]);
+        let mut m = [[0.0; K]; K];
+        let wp = sc.waypoints().positions();
+        let h_r = sc.mission().reference_altitude();
+        let records = (&mut min[..], &mut grad[..], &mut track[..]);
+        let (mut w, rows) = Watch::new((wp, 0, K), h_r, records, gn.then_some(&mut m));
+        let start = sc.start_state(z[0]);
+        sc.evaluate_watched(&start, 0, z, K, &mut w).unwrap();
+        ((min, grad, track), rows)
+    }
+
+    #[test]
+    fn records_are_the_segments_least_samples_either_way() {
+        let v = Vehicle::c_auv4().unwrap();
+        let x = [0.0, 150.0, 420.0, 700.0, 980.0, 1300.0, 1500.0];
+        let b = [300.0, 260.0, 340.0, 180.0, 240.0, 150.0, 200.0];
+        let p = Profile::<8>::new(&x, &b).unwrap();
+        let w = Waypoints::<4>::new(&[0.0, 450.0, 1000.0, 1450.0]).unwrap();
+        let sc =
+            Scenario::new(&v, &p, &w, Mission::new(40.0, 20.0, [0.0, 1000.0]).unwrap()).unwrap();
+        for z in [
+            [230.0, 170.0, 120.0],
+            [250.0, 120.0, 95.0],
+            [200.0, 200.0, 60.0],
+        ] {
+            let ((min, grad, track), rows) = watched(&sc, &z, false);
+            let ((min_gn, grad_gn, _), rows_gn) = watched(&sc, &z, true);
+            assert!(rows >= 2 * K && rows == rows_gn);
+            for s in 0..rows {
+                assert_eq!(min[s].to_bits(), min_gn[s].to_bits(), "segment {s}");
+                assert_eq!(grad[s], grad_gn[s], "segment {s}");
+                let t = usize::from(track[s]);
+                assert!(grad[s].iter().skip(t + 1).all(|&g| g == 0.0));
+            }
+            // Each segment's least sample, flown plainly.
+            let mut least = [f32::INFINITY; ROWS];
+            let (wp, mut scores) = (w.positions(), [TrackScore::default(); K]);
+            let start = sc.start_state(z[0]);
+            let mut seen = |s: &crate::sim::Sample| {
+                let Some((t, _)) = s.reference else { return };
+                let (a, end) = (wp[t], wp[t + 1]);
+                let first = (0..rows).find(|&r| usize::from(track[r]) == t).unwrap();
+                let n = (0..rows).filter(|&r| usize::from(track[r]) == t).count();
+                let k = (((s.x - a) * n as f32 / (end - a)).max(0.0) as usize).min(n - 1);
+                let h = p.depth_at(s.x).unwrap() - s.depth;
+                least[first + k] = least[first + k].min(h);
+            };
+            sc.simulate(&start, 0, &z, &mut scores, &mut seen).unwrap();
+            for s in 0..rows {
+                // (A segment's least may sit at a waypoint, between samples:
+                // within a step's climb of the samples' least.)
+                assert!(
+                    (min[s] - least[s]).abs() < 0.05,
+                    "segment {s}: {} vs {}",
+                    min[s],
+                    least[s]
+                );
             }
         }
     }
