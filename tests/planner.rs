@@ -353,6 +353,45 @@ fn gradient_descent_is_the_slow_baseline() {
     assert!(it(&gd) >= 150, "GD {}", it(&gd));
 }
 
+/// A random line of `tools/reference/check_planner.py` (`--seed 23`,
+/// case 2) on which the cold call's SQP ends infeasible with track 1 on a
+/// plateau (the pitch reference saturated: no gradient moves it): the
+/// plateau's scan must restore feasibility at the feasible depth of least
+/// `J` (1190 m there), not at the first feasible one (369 m, 53 times the
+/// best `J`). The best safe `J` is the checker's f64 beam search.
+#[test]
+fn a_plateau_restores_feasibility_at_its_best_feasible_depth() {
+    let dir = format!("{}/tests/fixtures/horizon", env!("CARGO_MANIFEST_DIR"));
+    let read = |file: &str| -> Vec<Vec<f32>> {
+        let text = std::fs::read_to_string(format!("{dir}/{file}")).unwrap();
+        text.lines()
+            .skip(1)
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect())
+            .collect()
+    };
+    let rows = read("plateau_restore.csv");
+    let (x, b): (Vec<f32>, Vec<f32>) = rows.iter().map(|r| (r[0], r[1])).unzip();
+    let wp: Vec<f32> = read("plateau_restore.waypoints.csv")
+        .iter()
+        .map(|r| r[1])
+        .collect();
+    let line = Line {
+        vehicle: Vehicle::new(&Default::default(), pad(auvnav::TransferFunction::C_AUV4)).unwrap(),
+        profile: Profile::new(&x, &b).unwrap(),
+        waypoints: Waypoints::new(&wp).unwrap(),
+        mission: Mission::new(80.0, 60.0, [0.0, 6000.0]).unwrap(),
+    };
+    let plans = plan_line(&line, PlannerConfig::default());
+    assert!(plans.iter().all(|p| p.1), "every track certified safe");
+    let total: f32 = plans.iter().map(|p| p.3.j()).sum();
+    let best_safe = 5_308_599.0;
+    assert!(
+        total <= 1.01 * best_safe,
+        "J {total} vs best safe {best_safe}"
+    );
+}
+
 #[test]
 fn warm_start_makes_later_calls_cheap() {
     let line = Line::real("us_monterey_canyon_2");

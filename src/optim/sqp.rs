@@ -140,7 +140,9 @@ pub(crate) trait Constrained<const K: usize> {
 /// each iterate appended to `out.history` (not monotone: an early iterate
 /// may be infeasible, and lower). `metric`: the first metric when given
 /// (a restart near a finished run keeps its curvature), else the
-/// Gauss–Newton matrix at `z0`; the final metric on return.
+/// Gauss–Newton matrix at `z0`; the final metric on return. Returns the
+/// ℓ1 merit's final penalty weight `ρ` (m³ of `J` per m of `v`; 0 when no
+/// constraint was ever active).
 ///
 /// # Errors
 /// [`OptimError`] when the objective fails or is not finite at the start.
@@ -151,7 +153,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     cfg: &BfgsConfig,
     feas_tol: f32,
     out: &mut Outcome<K>,
-) -> Result<(), OptimError<O::Error>> {
+) -> Result<f32, OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
     if !bounds.is_valid() {
         return Err(OptimError::Config(super::OptimConfigError::Bounds));
@@ -197,7 +199,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     out.evaluations = run.evaluations;
     out.skipped_updates = run.skipped;
     *metric = Some(run.a);
-    Ok(())
+    Ok(run.rho)
 }
 
 /// The state of one SQP run.

@@ -34,9 +34,10 @@
 //! track by track from the state the best of the previous track leaves:
 //! the search starts in the best basin found, never on a plateau that is
 //! not the best scanned value. A horizon of two tracks or more under BFGS
-//! is scanned as a beam: each track's grid from the end states of the
-//! three best paths so far (by summed `J + μ V`, one path per grid point),
-//! so that a depth which leaves a later track no safe depth loses. In horizon mode later calls start from the
+//! is scanned as a beam: each track's grid, over the depths reachable from
+//! its parent's end state, from the end states of the two best paths so
+//! far (by summed `J + μ V`, one path per grid point), so that a depth
+//! which leaves a later track no safe depth loses. In horizon mode later calls start from the
 //! previous call's plan, and only the newly visible track is scanned.
 //!
 //! **Constraint, one track** (track-wise mode, and the last track of a
@@ -70,8 +71,13 @@
 //! (about 5 cold, 0–1 warm on the Monterey lines), from any start: the
 //! starting point only picks the basin. A coordinate whose gradient is
 //! exactly zero (a plateau, contract §10) is scanned once, the tracks
-//! before it flown once for all its points; a later call that continues
-//! the plan does not scan it again.
+//! before it flown once for all its points; the SQP restarts from the
+//! best point (at most twice) when its gain in `J` covers its shortfall
+//! priced at a tenth of the merit weight `ρ`, and keeps the restart only
+//! if it ends better; a later call that continues the plan does not scan
+//! it again. Under declared uncertainty the targets are raised track by
+//! track by the certification gap (`gaps.rs`), so that the optimum is the
+//! certified one.
 //!
 //! **Constraint, a horizon, under GD** (the paper's baseline). `h >= h_a`
 //! enters the optimization as a quadratic penalty: `Φ = Σ J + μ Σ V` with
@@ -94,7 +100,11 @@
 //! of the line certified in every declared world (model contract §11,
 //! §12), so the flown line is safe whatever the horizon, the iteration cap
 //! or the budget, and [`PlanStatus::Infeasible`] comes from the first call
-//! that finds no certified continuation. The statuses: optimal (certified,
+//! that finds no certified continuation. A later call keeps the previous
+//! call's continuation, whose certificate it knows (the worlds start
+//! where that call predicted), unless its candidate lowers the line's `J`
+//! by more than 0.1 %; the worlds' states are flown on only when a
+//! certificate needs them. The statuses: optimal (certified,
 //! the constraint not active), constrained (certified, on the boundary),
 //! infeasible; why the optimizer stopped is [`OptimizerStop`], apart.
 //! Track-wise mode (the paper's) certifies the committed track alone and
@@ -112,6 +122,7 @@
 //! | `resumable.rs` | [`Resumable`]: one call as bounded steps |
 //! | `candidate.rs` | one call's candidate, step by step |
 //! | `commit.rs` | what is committed: the certified continuation (§11) |
+//! | `search.rs` | the continuation search from a certified anchor (§11) |
 //! | `gaps.rs` | the SQP's targets raised by the certification gap (§12) |
 //! | `certify.rs` | certificates over the declared worlds (§12), [`certify_line`] |
 //! | `flights.rs` | the call's plain flights, counted |
