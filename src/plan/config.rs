@@ -46,10 +46,12 @@ pub struct PlannerConfig {
     /// back to safe depths. Default true.
     pub constrained: bool,
     /// Penalty weight `μ` of the first stage, dimensionless (`J` and the
-    /// violation are both m³). Default 1e4.
+    /// violation are both m³). Default 1e4. Used by gradient descent, a
+    /// single track and the scan's `J + μ V`; a horizon under BFGS is an
+    /// SQP, without a penalty in its objective.
     pub penalty_weight: f32,
-    /// Penalty stages: each re-solves with `μ` ×100 while the optimum still
-    /// violates. ≥ 1. Default 2 (μ up to 1e6). A warm-started call starts
+    /// Penalty stages (gradient descent, a single track): each re-solves with `μ` ×100
+    /// while the optimum still violates. ≥ 1. Default 2 (μ up to 1e6). A warm-started call starts
     /// at the `μ` the previous call ended with.
     pub penalty_stages: u32,
     /// Penalty margin `m_p` above `h_a` for horizons of two tracks or
