@@ -392,10 +392,7 @@ impl<const K: usize> Work<K> {
 #[cfg(test)]
 #[allow(clippy::needless_range_loop)]
 mod tests {
-    extern crate std;
     use super::*;
-    use std::vec;
-    use std::vec::Vec as SVec;
 
     struct Lcg(u64);
     impl Lcg {
@@ -419,17 +416,17 @@ mod tests {
         g: &[f64; 4],
         n: usize,
         rows: &[([f64; 4], f64)],
-    ) -> Option<(SVec<f64>, f64)> {
+    ) -> Option<([f64; 4], f64)> {
         let m = rows.len();
-        let mut best: Option<(SVec<f64>, f64)> = None;
+        let mut best: Option<([f64; 4], f64)> = None;
         for mask in 0u32..(1 << m) {
-            let act: SVec<usize> = (0..m).filter(|i| mask >> i & 1 == 1).collect();
+            let act: Vec<usize, 16> = (0..m).filter(|i| mask >> i & 1 == 1).collect();
             if act.len() > n {
                 continue;
             }
-            // KKT: [G -Aᵀ; A 0] [d; λ] = [-g; -c]
+            // KKT: [G -Aᵀ; A 0] [d; λ] = [-g; -c] (at most 8 unknowns).
             let s = n + act.len();
-            let mut kk = vec![vec![0.0; s + 1]; s];
+            let mut kk = [[0.0f64; 9]; 8];
             for i in 0..n {
                 for j in 0..n {
                     kk[i][j] = g_mat[i][j];
@@ -466,9 +463,10 @@ mod tests {
             if !ok {
                 continue;
             }
-            let sol: SVec<f64> = (0..s).map(|i| kk[i][s] / kk[i][i]).collect();
+            let sol: [f64; 8] =
+                core::array::from_fn(|i| if i < s { kk[i][s] / kk[i][i] } else { 0.0 });
             let d = &sol[..n];
-            if sol[n..].iter().any(|&l| l < -1e-9) {
+            if sol[n..s].iter().any(|&l| l < -1e-9) {
                 continue;
             }
             if rows
@@ -481,7 +479,10 @@ mod tests {
                 .map(|i| 0.5 * d[i] * (0..n).map(|j| g_mat[i][j] * d[j]).sum::<f64>() + g[i] * d[i])
                 .sum();
             if best.as_ref().is_none_or(|b| f < b.1) {
-                best = Some((d.to_vec(), f));
+                best = Some((
+                    core::array::from_fn(|i| d.get(i).copied().unwrap_or(0.0)),
+                    f,
+                ));
             }
         }
         best
@@ -511,14 +512,14 @@ mod tests {
                 }
             }
             let g: [f64; 4] = core::array::from_fn(|_| scale * 10.0 * rng.sym());
-            let mut rows: SVec<([f64; 4], f64)> = (0..m)
+            let mut rows: Vec<([f64; 4], f64), 10> = (0..m)
                 .map(|_| (core::array::from_fn(|_| rng.sym()), 5.0 * rng.sym()))
                 .collect();
             // Near-parallel rows, as neighbouring segments of one track
             // give: a copy of a row nudged by 1e-3.
             if m > 0 && m < 9 && case % 3 == 0 {
                 let (a, c) = rows[0];
-                rows.push((a.map(|v| v + 1e-3 * rng.sym()), c + 1e-3 * rng.sym()));
+                let _ = rows.push((a.map(|v| v + 1e-3 * rng.sym()), c + 1e-3 * rng.sym()));
             }
             let expect = brute(&gm, &g, n, &rows);
             let g_mat: Mat<4> = core::array::from_fn(|i| core::array::from_fn(|j| gm[i][j] as f32));
@@ -551,8 +552,8 @@ mod tests {
                 (e, g) => panic!("case {case}: brute {e:?}, solver {g:?}"),
             }
         }
-        std::println!("{solved} of 400 solved");
-        assert!(solved > 250, "{solved}");
+        // (Most random problems have a solution: the test compares them.)
+        assert!(solved > 250, "{solved} of 400 solved");
     }
 
     #[test]
