@@ -44,8 +44,10 @@ for path in sorted(pathlib.Path("src").rglob("*.rs")):
     if len(path.relative_to("src").parts) > 1:
         for m in SUPER.finditer(code):
             sib = m.group(1)
-            if sib != module(path) and (path.parent / f"{sib}.rs").exists():
-                edges.setdefault(str(path), set()).add(str(path.parent / f"{sib}.rs"))
+            # A sibling is a file or a folder's mod.rs.
+            for target in (path.parent / f"{sib}.rs", path.parent / sib / "mod.rs"):
+                if sib != module(path) and target.exists():
+                    edges.setdefault(str(path), set()).add(str(target))
 
 # Cycles between sibling files (items re-exported by mod.rs count as mod.rs's,
 # so only direct `super::file` paths form edges).

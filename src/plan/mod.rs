@@ -95,7 +95,7 @@
 //! the optimum (among the scanned depths, then by the boundary search), or
 //! the safest depth it found.
 //!
-//! **Certification and commitment** (`commit.rs`, `certify.rs`). In
+//! **Certification and commitment** (`commit.rs`, `certify/`). In
 //! horizon mode the depth is committed only with a continuation to the end
 //! of the line certified in every declared world (model contract §11,
 //! §12), so the flown line is safe whatever the horizon, the iteration cap
@@ -124,7 +124,7 @@
 //! | `commit.rs` | what is committed: the certified continuation (§11) |
 //! | `search.rs` | the continuation search from a certified anchor (§11) |
 //! | `gaps.rs` | the SQP's targets raised by the certification gap (§12) |
-//! | `certify.rs` | certificates over the declared worlds (§12), [`certify_line`] |
+//! | `certify/` | certificates over the declared worlds (§12), [`certify_line`]; the worlds' states between calls (`states.rs`) |
 //! | `flights.rs` | the call's plain flights, counted |
 //! | `solve.rs` | the optimizer runs: the SQP (BFGS), penalty stages (GD), plateau escape |
 //! | `scan.rs` | the search box and the coarse scan (the starting point) |
