@@ -143,10 +143,29 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let iterations =
             self.escape_plateaus(&mut obj, (s.h, &s.bounds), first_step, iterations)?;
         self.committed_to_boundary(&mut obj, (s.h, &s.bounds));
+        let last = obj.last_flight;
+        let (answer, warm) = ((iterations, None), (obj.mu, 0));
+        self.finish((&mut fl, &s, &mut scan), (&obj, last), answer, warm)
+    }
+
+    /// The candidate of an optimizer's answer: `obj`'s flights counted, its
+    /// depth verified (`last`: the optimizer's last one-track flight, if
+    /// that depth's), the warm start kept (`warm`: `μ`, the plateaus
+    /// scanned), with the call's `iterations` and `previous_j`.
+    fn finish(
+        &mut self,
+        (fl, s, scan): (&mut Flights<'_, '_, N>, &Setup<K>, &mut ScanLog),
+        (obj, last): (
+            &PlanObjective<'_, N>,
+            Option<(f32, TrackScore, VehicleState<N>)>,
+        ),
+        (iterations, previous_j): (u32, Option<f32>),
+        warm: (f32, u64),
+    ) -> Result<Candidate<N>, PlanError> {
         fl.count = fl.count.saturating_add(obj.evaluations);
         let spent = obj.evaluations >= obj.budget;
-        let (f, found) = self.verify(&mut fl, &s, (obj.last_flight, spent), &mut scan)?;
-        self.keep_warm(track, s.h, f.depth, (obj.mu, 0));
+        let (f, found) = self.verify(fl, s, (last, spent), scan)?;
+        self.keep_warm(fl.track, s.h, f.depth, warm);
         self.horizon_len = s.h;
         Ok(Candidate {
             flown: f,
@@ -155,7 +174,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             evaluations: fl.count,
             h_safe: s.h_safe,
             cert: None,
-            previous_j: None,
+            previous_j,
         })
     }
 
@@ -228,20 +247,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if certifying {
             iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), (tol, s.h_safe))?;
         }
-        fl.count = fl.count.saturating_add(obj.evaluations);
-        let spent = obj.evaluations >= obj.budget;
-        let (f, found) = self.verify(fl, s, (None, spent), scan)?;
-        self.keep_warm(fl.track, s.h, f.depth, (0.0, plateaus));
-        self.horizon_len = s.h;
-        Ok(Candidate {
-            flown: f,
-            found,
-            iterations,
-            evaluations: fl.count,
-            h_safe: s.h_safe,
-            cert: None,
-            previous_j,
-        })
+        let answer = (iterations, previous_j);
+        self.finish((fl, s, scan), (&obj, None), answer, (0.0, plateaus))
     }
 
     /// The scan's decision of a constrained single track (module docs of

@@ -25,7 +25,7 @@ use crate::model::ProfileView;
 use crate::sim::{Scenario, TrackScore, VehicleState, World};
 
 use super::candidate::Candidate;
-use super::certify::{ALL, Certificate, Tube, vehicle_margin};
+use super::certify::{ALL, Certificate, Tube};
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::{Continuation, MAX_TRACKS};
@@ -63,7 +63,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         cand: Candidate<N>,
     ) -> Result<Plan<N>, PlanError> {
         let bottom = certification_bottom(sc)?;
-        let kept = self.prepare_tube(sc, state, track);
+        let kept = self.tube.prepare_for(sc, state, track);
         if !kept {
             self.line_j = 0.0;
         }
@@ -102,24 +102,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
         let status = self.status(sc, &cand, &chosen, safe);
         Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
-    }
-
-    /// The tube's worlds for this call, its states kept when the vehicle
-    /// is where they predicted ([`Tube::prepare`]). Not inlined: the
-    /// declared worlds' list stays off the certifying path's stack.
-    #[inline(never)]
-    fn prepare_tube(
-        &mut self,
-        sc: &Scenario<'_, N>,
-        state: &VehicleState<N>,
-        track: usize,
-    ) -> bool {
-        let u = sc.mission().uncertainty();
-        let worlds = (
-            World::corners(sc.vehicle(), u),
-            vehicle_margin(sc.vehicle(), u),
-        );
-        self.tube.prepare(worlds, state, track)
     }
 
     /// The continuation to commit and its certificate: the known one
@@ -232,7 +214,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return Err(PlanError::LineTooLong);
         }
         let shallow = sc.mission().depth_limits()[0];
-        let c = self.candidate_continuation(track, len, cand.flown.depth, shallow);
+        let horizon = (&self.work.z, self.horizon_len);
+        let c = self.candidate_continuation((track, len), (cand.flown.depth, horizon), shallow);
         let cert_c = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
         let candidate = Chosen {
             depths: c,
@@ -369,14 +352,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         Some(a)
     }
 
-    /// The candidate continuation: the call's depth, its optimized
-    /// horizon, then the previous continuation beyond it (or the climb to
-    /// `shallow`, m).
+    /// The candidate continuation: the call's depth, the rest of its
+    /// optimized horizon (`z`, `h` tracks), then the previous continuation
+    /// beyond it (or the climb to `shallow`, m).
     pub(super) fn candidate_continuation(
         &self,
-        track: usize,
-        len: usize,
-        depth: f32,
+        (track, len): (usize, usize),
+        (depth, (z, h)): (f32, (&[f32; K], usize)),
         shallow: f32,
     ) -> [f32; MAX_TRACKS] {
         let mut c = [shallow; MAX_TRACKS];
@@ -384,7 +366,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let t = track.saturating_add(i);
             *slot = match i {
                 0 => depth,
-                i if i < self.horizon_len => self.work.z.get(i).copied().unwrap_or(shallow),
+                i if i < h => z.get(i).copied().unwrap_or(shallow),
                 _ => self.cont.depth(t).unwrap_or(shallow),
             };
         }

@@ -22,9 +22,9 @@
 //! over.
 
 use crate::optim::Bounds;
-use crate::sim::{Scenario, World};
+use crate::sim::Scenario;
 
-use super::certify::{MAX_TRACKS, Worlds, vehicle_margin};
+use super::certify::{MAX_TRACKS, Worlds};
 use super::commit::{certification_bottom, nominal_only};
 use super::objective::PlanObjective;
 use super::{PlanError, Planner};
@@ -45,12 +45,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<Option<Worlds>, PlanError> {
         let (state, track) = (*obj.start, obj.track);
         let bottom = certification_bottom(sc)?;
-        let u = sc.mission().uncertainty();
-        let worlds = (
-            World::corners(sc.vehicle(), u),
-            vehicle_margin(sc.vehicle(), u),
-        );
-        self.tube.prepare(worlds, &state, track);
+        self.tube.prepare_for(sc, &state, track);
         if nominal_only(sc, bottom, &self.tube, &state) {
             return Ok(None);
         }
@@ -70,7 +65,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// stack of the solve that follows.
     #[inline(never)]
     fn screen_gaps(
-        &mut self,
+        &self,
         sc: &Scenario<'_, N>,
         obj: &mut PlanObjective<'_, N>,
         (z, h, mask): (&[f32; K], usize, Worlds),
@@ -83,12 +78,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             .saturating_sub(track)
             .min(MAX_TRACKS);
         let shallow = sc.mission().depth_limits()[0];
-        let saved = self.work.z;
-        self.work.z = *z;
-        self.horizon_len = h;
         let depth = z.first().copied().unwrap_or(shallow);
-        let c = self.candidate_continuation(track, len, depth, shallow);
-        self.work.z = saved;
+        let c = self.candidate_continuation((track, len), (depth, (z, h)), shallow);
         let mut certified = [f32::INFINITY; MAX_TRACKS];
         let mut flights = 0_u32;
         let d = c.get(..len).unwrap_or(&[]);

@@ -188,6 +188,12 @@ impl<const N: usize> PlanObjective<'_, N> {
         self.sc
             .fly(at_j, self.track.saturating_add(j), used, tail)
             .map_err(Stop::Sim)?;
+        self.value_of(&scores)
+    }
+
+    /// `(Σ J, v)` of the horizon's `scores` (m³, m): a non-finite `J` is
+    /// a diverged flight.
+    fn value_of(&self, scores: &[TrackScore]) -> Result<(f32, f32), Stop> {
         let sc = scores.get(..self.count).unwrap_or(&[]);
         let total: f32 = sc.iter().map(TrackScore::j).sum();
         if total.is_finite() {
@@ -290,12 +296,6 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
 
     fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Stop> {
         let scores = self.flight(z)?;
-        let sc = scores.get(..self.count).unwrap_or(&[]);
-        let j: f32 = sc.iter().map(TrackScore::j).sum();
-        if j.is_finite() {
-            Ok((j, self.infeasibility(sc)))
-        } else {
-            Err(Stop::Sim(SimError::Diverged))
-        }
+        self.value_of(&scores)
     }
 }

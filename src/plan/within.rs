@@ -3,11 +3,11 @@
 //! candidate within its share, the fallback (see `budget.rs`).
 
 use crate::model::ProfileView;
-use crate::sim::{Scenario, SimError, TrackScore, VehicleState, World};
+use crate::sim::{Scenario, SimError, TrackScore, VehicleState};
 
 use super::budget::Budget;
 use super::candidate::Candidate;
-use super::certify::{Certificate, vehicle_margin};
+use super::certify::Certificate;
 use super::commit::{certification_bottom, nominal_only};
 use super::fallback::Flown;
 use super::flights::Flights;
@@ -82,12 +82,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         limit: u32,
     ) -> Result<(Budget, u32), PlanError> {
         let bottom = certification_bottom(sc)?;
-        let u = sc.mission().uncertainty();
-        let worlds = World::corners(sc.vehicle(), u);
-        let w = u32::try_from(worlds.len()).unwrap_or(u32::MAX);
-        let kept = self
-            .tube
-            .prepare((worlds, vehicle_margin(sc.vehicle(), u)), state, track);
+        let kept = self.tube.prepare_for(sc, state, track);
+        let w = u32::try_from(self.tube.count()).unwrap_or(u32::MAX);
         let nominal = nominal_only(sc, bottom, &self.tube, state);
         let guaranteed = self.cfg.mode == Mode::Horizon && self.cfg.constrained;
         let len = sc.waypoints().tracks().saturating_sub(track);

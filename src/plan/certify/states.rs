@@ -8,9 +8,31 @@ use heapless::Vec;
 use crate::model::ProfileView;
 use crate::sim::{MAX_WORLDS, Scenario, SimError, TrackScore, VehicleState, World};
 
-use super::{ALL, Tube, Worlds, has};
+use super::{ALL, Tube, Worlds, has, vehicle_margin};
 
 impl<const N: usize> Tube<N> {
+    /// [`Tube::prepare`] with the worlds and vehicle margin `sc` declares.
+    /// Not inlined: the worlds' list stays off its callers' stack.
+    #[inline(never)]
+    pub fn prepare_for(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+    ) -> bool {
+        let u = sc.mission().uncertainty();
+        let worlds = (
+            World::corners(sc.vehicle(), u),
+            vehicle_margin(sc.vehicle(), u),
+        );
+        self.prepare(worlds, state, track)
+    }
+
+    /// How many worlds the tube flies.
+    pub fn count(&self) -> usize {
+        self.worlds.len()
+    }
+
     /// Makes the tube ready for a call on `track` from `state`: kept if it
     /// is the state the last commit predicted for this track with the same
     /// worlds, else every world starts from `state`. Returns whether it
@@ -137,10 +159,9 @@ impl<const N: usize> Tube<N> {
         } else {
             for (w, st) in self.worlds.iter().zip(self.states.iter_mut()) {
                 *flights = flights.saturating_add(1);
-                let mut score = [TrackScore::default()];
                 let next = sc
                     .in_world(w, bottom)
-                    .and_then(|scw| scw.fly(st, self.track, &[depth], &mut score));
+                    .and_then(|scw| fly_on(&scw, st, self.track, &[depth]));
                 match next {
                     Ok(n) => *st = n,
                     Err(_) => {
