@@ -259,7 +259,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             };
             if cert_a.all >= cand.h_safe {
                 let ends = ((&a, cert_a), (&c, cert_c));
-                return Ok(self.search(sc, bottom, ends, len, cand.h_safe, flights));
+                let found = self.search(sc, bottom, ends, len, cand.h_safe, flights);
+                return Ok(self.search_committed(sc, bottom, found, (&c, len), cand, flights));
             }
             if cert_a.all > best.cert.all {
                 best = Chosen {
