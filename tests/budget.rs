@@ -144,7 +144,7 @@ fn every_call_stays_within_its_budget_and_the_line_stays_safe() {
 #[test]
 fn from_measured_states_too() {
     let vehicle = Vehicle::c_auv4().unwrap();
-    for (name, h_r, h_a) in [LINES[0], LINES[3]] {
+    for (name, h_r, h_a) in [LINES[0], LINES[3], LINES[4], LINES[5]] {
         let (map, wps) = line(name);
         let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
         let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();

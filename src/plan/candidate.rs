@@ -17,7 +17,7 @@ use super::objective::PlanObjective;
 use super::planner::Warm;
 use super::scan::{ScanLog, ScanSpec, scan_start, search_box};
 use super::single::{self, Decision};
-use super::solve::{LATER_SHARE, Merge};
+use super::solve::{Merge, later_margin};
 use super::status::{Found, OptimizerStop};
 use super::{Method, Mode, PlanError, Planner};
 
@@ -224,7 +224,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let later = if declared {
                 0.0
             } else {
-                LATER_SHARE * self.cfg.penalty_margin
+                later_margin(&self.cfg, m)
             };
             obj.target = (s.h_safe + tol, s.h_safe + tol + later);
             obj.band = (m.reference_altitude() - m.min_altitude()).max(SQP_BAND);
