@@ -1,6 +1,8 @@
 //! The continuation search: the last certified point on the straight
-//! path from a certified anchor towards the candidate continuation
-//! ([`super::commit`] calls it when the candidate does not certify).
+//! path from a certified anchor towards the candidate continuation, then
+//! on the second leg that moves the committed depth alone towards the
+//! candidate's ([`super::commit`] calls it when the candidate does not
+//! certify).
 
 use crate::model::ProfileView;
 use crate::optim::root::{self, RootTol};
