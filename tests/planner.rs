@@ -392,6 +392,64 @@ fn a_plateau_restores_feasibility_at_its_best_feasible_depth() {
     );
 }
 
+/// A single track on a plateau (the pitch reference saturated over the
+/// whole track: every shallower depth climbs at full pitch, `J` is flat and
+/// its gradient exactly zero) escapes it: track 4 of a random line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 41`, `unseen_41_4`)
+/// starts 1 230 m deep under a rising bottom, and the scan's best depth
+/// (860.8 m, `J` 58 689 m³) is on the plateau. The f64 checker's best from
+/// the same start, the earlier tracks flown at the same depths, is
+/// 23 073.6 m³ at 973.61 m; constrained (the earlier tracks at their own
+/// constrained depths), the best safe is 12 865.6 m³ at 974.27 m, where
+/// the scan's 804.3 m (58 336 m³) was on the plateau.
+#[test]
+fn a_single_track_leaves_its_plateau() {
+    let dir = format!("{}/tests/fixtures/horizon", env!("CARGO_MANIFEST_DIR"));
+    let read = |file: &str| -> Vec<Vec<f32>> {
+        let text = std::fs::read_to_string(format!("{dir}/{file}")).unwrap();
+        text.lines()
+            .skip(1)
+            .filter(|l| !l.trim().is_empty())
+            .map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect())
+            .collect()
+    };
+    let rows = read("plateau_single.csv");
+    let (x, b): (Vec<f32>, Vec<f32>) = rows.iter().map(|r| (r[0], r[1])).unzip();
+    let wp: Vec<f32> = read("plateau_single.waypoints.csv")
+        .iter()
+        .map(|r| r[1])
+        .collect();
+    let line = Line {
+        vehicle: Vehicle::new(&Default::default(), pad(auvnav::TransferFunction::C_AUV4)).unwrap(),
+        profile: Profile::new(&x, &b).unwrap(),
+        waypoints: Waypoints::new(&wp).unwrap(),
+        mission: Mission::new(80.0, 60.0, [0.0, 6000.0]).unwrap(),
+    };
+    let cfg = PlannerConfig {
+        mode: Mode::TrackWise,
+        constrained: false,
+        ..Default::default()
+    };
+    let plans = plan_line(&line, cfg);
+    let j4 = plans[3].3.j();
+    assert!(
+        j4 <= 1.005 * 23_073.6,
+        "track 4: J {j4} at {} m vs the best 23 073.6 at 973.61 m",
+        plans[3].2
+    );
+    let cfg = PlannerConfig {
+        constrained: true,
+        ..cfg
+    };
+    let plans = plan_line(&line, cfg);
+    let (safe, j4) = (plans[3].1, plans[3].3.j());
+    assert!(
+        safe && j4 <= 1.005 * 12_865.6,
+        "track 4 (safe {safe}): J {j4} at {} m vs the best safe 12 865.6 at 974.27 m",
+        plans[3].2
+    );
+}
+
 #[test]
 fn warm_start_makes_later_calls_cheap() {
     let line = Line::real("us_monterey_canyon_2");

@@ -143,6 +143,7 @@ mod flights;
 mod gaps;
 mod objective;
 mod planner;
+mod plateau;
 mod resumable;
 mod scan;
 mod search;

@@ -2,12 +2,13 @@
 //! minimum-altitude constraints (`optim::sqp`) and its plateau escape.
 //! Under GD (the paper's baseline): one optimizer run merged onto the
 //! planner's workspace, the sequential penalty stages (N&W §17.1: `μ`
-//! ×100 while the optimum still violates), the plateau escape, and the
-//! committed track moved onto the certified boundary.
+//! ×100 while the optimum still violates), the plateau escape (a single
+//! track's: `plateau.rs`), and the committed track moved onto the
+//! certified boundary.
 
+use crate::model::Mission;
 use crate::optim::root::{self, RootTol};
 use crate::optim::sqp::sqp_into;
-use crate::model::Mission;
 use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
 use crate::sim::{SimError, TrackScore};
 
@@ -369,7 +370,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         mut iterations: u32,
     ) -> Result<u32, PlanError> {
         if h <= 1 {
-            return Ok(iterations);
+            return self.escape_plateau_single(obj, bounds, first_step, iterations);
         }
         let cap = self.cfg.bfgs.max_iterations;
         for j in 0..h {

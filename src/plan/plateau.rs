@@ -1,0 +1,154 @@
+//! A single track's plateau (model contract §10): where the pitch reference
+//! stays saturated over the whole track, the track's depth moves nothing,
+//! `J` is flat and its gradient exactly zero, and the optimizer stops
+//! there although a better depth may lie past the plateau's edge (a
+//! vehicle climbing at full pitch to a rising bottom: every shallower
+//! depth flies the same). The edge is found by stepping out of the
+//! plateau (steps doubling from 1/64 of the box) and a few halvings; the
+//! optimizer restarts from the first depth past it, on each side, and its
+//! answer is kept if it ends lower. (A horizon scans its flat
+//! coordinates instead, `solve.rs`.)
+
+use crate::num::{max, min};
+use crate::optim::Bounds;
+
+use super::objective::PlanObjective;
+use super::solve::Merge;
+use super::{PlanError, Planner};
+
+/// The outward search's first step, of the box.
+const FIRST_STEP_SHARE: f32 = 1.0 / 64.0;
+
+/// Halvings of the bracket around the edge (the restart needs a depth
+/// past the edge, not the edge itself).
+const HALVINGS: u32 = 4;
+
+impl<const K: usize, const N: usize> Planner<K, N> {
+    /// The single track's plateau escape (module docs), after the
+    /// optimizer: from a plateau (gradient exactly zero), a restart from
+    /// each of its edges within the box. Returns the iterations so far (a
+    /// restart counts one more).
+    pub(super) fn escape_plateau_single(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        bounds: &Bounds<K>,
+        first_step: f32,
+        mut iterations: u32,
+    ) -> Result<u32, PlanError> {
+        let w = &self.work;
+        let (Some(&z), Some(&g), Some(&lo), Some(&hi)) = (
+            w.z.first(),
+            w.gradient.first(),
+            bounds.lo.first(),
+            bounds.hi.first(),
+        ) else {
+            return Ok(iterations);
+        };
+        if g != 0.0 || lo >= hi {
+            return Ok(iterations);
+        }
+        let (flat, mut start) = (w.j, w.z);
+        let cap = self.cfg.bfgs.max_iterations;
+        for dir in [1.0_f32, -1.0] {
+            let Some(edge) = plateau_edge(obj, (lo, hi), (z, flat), dir, &mut start) else {
+                continue;
+            };
+            let budget = cap.saturating_sub(iterations).saturating_sub(1);
+            if budget == 0 {
+                break;
+            }
+            if let Some(s) = start.first_mut() {
+                *s = edge;
+            }
+            if let Some(taken) =
+                self.restart_off_plateau(obj, &start, bounds, (first_step, budget))?
+            {
+                iterations = iterations.saturating_add(taken).saturating_add(1);
+            }
+        }
+        Ok(iterations)
+    }
+
+    /// The optimizer restarted from `start`, kept if it ends lower. A
+    /// guarded run (the constrained single track, whose objective is `J`
+    /// alone) restarts unguarded, so that a trial step past the safe set
+    /// does not end it (its first run's boundary search would take such a
+    /// step for an optimum beyond the boundary), and keeps its end only if
+    /// that is safe. Returns the iterations when kept.
+    fn restart_off_plateau(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        start: &[f32; K],
+        bounds: &Bounds<K>,
+        run: (f32, u32),
+    ) -> Result<Option<u32>, PlanError> {
+        let w = &self.work;
+        let kept = (w.z, w.j, w.gradient, w.grad_norm, w.status);
+        let counts = (w.iterations, w.skipped_updates, w.history.len());
+        let guard = obj.guard.take();
+        let zero = [0.0; K];
+        let taken = self.optimize_onto(obj, start, bounds, run, &zero, Merge::IfBetter);
+        obj.guard = guard;
+        let Some(taken) = taken? else {
+            return Ok(None);
+        };
+        let Some(h_safe) = guard else {
+            return Ok(Some(taken));
+        };
+        let end = self.work.z;
+        let safe = obj
+            .flight(&end)
+            .ok()
+            .and_then(|s| s.first().map(|s| s.min_altitude() >= h_safe));
+        if safe == Some(true) {
+            return Ok(Some(taken));
+        }
+        let w = &mut self.work;
+        (w.z, w.j, w.gradient, w.grad_norm, w.status) = kept;
+        (w.iterations, w.skipped_updates) = (counts.0, counts.1);
+        w.history.truncate(counts.2);
+        Ok(None)
+    }
+}
+
+/// The first depth found past the edge of the plateau at `z` (its value
+/// `flat`) in direction `dir` (±1) within `[lo, hi]`, or `None` if the
+/// plateau reaches the box's end (or a flight fails). `probe` is the point flown (its first entry is set).
+fn plateau_edge<const N: usize, const K: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    (lo, hi): (f32, f32),
+    (z, flat): (f32, f32),
+    dir: f32,
+    probe: &mut [f32; K],
+) -> Option<f32> {
+    let mut value_at = |t: f32| {
+        if let Some(s) = probe.first_mut() {
+            *s = t;
+        }
+        obj.flight_value(probe).ok()
+    };
+    let is_flat = |v: f32| libm::fabsf(v - flat) <= 1e-6 * libm::fabsf(flat);
+    let (mut inside, mut step) = (z, FIRST_STEP_SHARE * (hi - lo));
+    let mut out = loop {
+        // (Not `f32::clamp`, which asserts its bounds' order.)
+        let t = min(max(inside + dir * step, lo), hi);
+        if t.to_bits() == inside.to_bits() {
+            return None;
+        }
+        if is_flat(value_at(t)?) {
+            inside = t;
+            step *= 2.0;
+        } else {
+            break t;
+        }
+    };
+    for _ in 0..HALVINGS {
+        let mid = 0.5 * (inside + out);
+        if is_flat(value_at(mid)?) {
+            inside = mid;
+        } else {
+            out = mid;
+        }
+    }
+    Some(out)
+}
