@@ -361,6 +361,21 @@ fn gradient_descent_is_the_slow_baseline() {
 /// best `J`). The best safe `J` is the checker's f64 beam search.
 #[test]
 fn a_plateau_restores_feasibility_at_its_best_feasible_depth() {
+    let line = fixture_line("plateau_restore");
+    let plans = plan_line(&line, PlannerConfig::default());
+    assert!(plans.iter().all(|p| p.1), "every track certified safe");
+    let total: f32 = plans.iter().map(|p| p.3.j()).sum();
+    let best_safe = 5_308_599.0;
+    assert!(
+        total <= 1.01 * best_safe,
+        "J {total} vs best safe {best_safe}"
+    );
+}
+
+/// A line from `tests/fixtures/horizon/{name}.csv` and
+/// `{name}.waypoints.csv` (a random line of `tools/reference/check_planner.py`),
+/// default vehicle, `h_r`/`h_a` 80/60 m.
+fn fixture_line(name: &str) -> Line {
     let dir = format!("{}/tests/fixtures/horizon", env!("CARGO_MANIFEST_DIR"));
     let read = |file: &str| -> Vec<Vec<f32>> {
         let text = std::fs::read_to_string(format!("{dir}/{file}")).unwrap();
@@ -370,26 +385,18 @@ fn a_plateau_restores_feasibility_at_its_best_feasible_depth() {
             .map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect())
             .collect()
     };
-    let rows = read("plateau_restore.csv");
+    let rows = read(&format!("{name}.csv"));
     let (x, b): (Vec<f32>, Vec<f32>) = rows.iter().map(|r| (r[0], r[1])).unzip();
-    let wp: Vec<f32> = read("plateau_restore.waypoints.csv")
+    let wp: Vec<f32> = read(&format!("{name}.waypoints.csv"))
         .iter()
         .map(|r| r[1])
         .collect();
-    let line = Line {
+    Line {
         vehicle: Vehicle::new(&Default::default(), pad(auvnav::TransferFunction::C_AUV4)).unwrap(),
         profile: Profile::new(&x, &b).unwrap(),
         waypoints: Waypoints::new(&wp).unwrap(),
         mission: Mission::new(80.0, 60.0, [0.0, 6000.0]).unwrap(),
-    };
-    let plans = plan_line(&line, PlannerConfig::default());
-    assert!(plans.iter().all(|p| p.1), "every track certified safe");
-    let total: f32 = plans.iter().map(|p| p.3.j()).sum();
-    let best_safe = 5_308_599.0;
-    assert!(
-        total <= 1.01 * best_safe,
-        "J {total} vs best safe {best_safe}"
-    );
+    }
 }
 
 /// A single track on a plateau (the pitch reference saturated over the
@@ -404,27 +411,7 @@ fn a_plateau_restores_feasibility_at_its_best_feasible_depth() {
 /// the scan's 804.3 m (58 336 m³) was on the plateau.
 #[test]
 fn a_single_track_leaves_its_plateau() {
-    let dir = format!("{}/tests/fixtures/horizon", env!("CARGO_MANIFEST_DIR"));
-    let read = |file: &str| -> Vec<Vec<f32>> {
-        let text = std::fs::read_to_string(format!("{dir}/{file}")).unwrap();
-        text.lines()
-            .skip(1)
-            .filter(|l| !l.trim().is_empty())
-            .map(|l| l.split(',').map(|v| v.trim().parse().unwrap()).collect())
-            .collect()
-    };
-    let rows = read("plateau_single.csv");
-    let (x, b): (Vec<f32>, Vec<f32>) = rows.iter().map(|r| (r[0], r[1])).unzip();
-    let wp: Vec<f32> = read("plateau_single.waypoints.csv")
-        .iter()
-        .map(|r| r[1])
-        .collect();
-    let line = Line {
-        vehicle: Vehicle::new(&Default::default(), pad(auvnav::TransferFunction::C_AUV4)).unwrap(),
-        profile: Profile::new(&x, &b).unwrap(),
-        waypoints: Waypoints::new(&wp).unwrap(),
-        mission: Mission::new(80.0, 60.0, [0.0, 6000.0]).unwrap(),
-    };
+    let line = fixture_line("plateau_single");
     let cfg = PlannerConfig {
         mode: Mode::TrackWise,
         constrained: false,
@@ -446,6 +433,28 @@ fn a_single_track_leaves_its_plateau() {
     assert!(
         safe && j4 <= 1.005 * 12_865.6,
         "track 4 (safe {safe}): J {j4} at {} m vs the best safe 12 865.6 at 974.27 m",
+        plans[3].2
+    );
+}
+
+/// A constrained single track whose optimizer overshot into the unsafe
+/// set returns to the interior optimum: track 4 of `unseen_41_3` (seed
+/// 41) tripped from far above and its boundary search stopped on the
+/// boundary at 1 026.57 m (`J` 26 061 m³), where `J` rises towards the
+/// boundary; the f64 checker's best safe from the same start is 13 886.7
+/// m³ at 1 018.86 m, 6.6 m inside.
+#[test]
+fn an_overshoot_into_the_unsafe_set_returns_to_the_interior_optimum() {
+    let line = fixture_line("overshoot_single");
+    let cfg = PlannerConfig {
+        mode: Mode::TrackWise,
+        ..Default::default()
+    };
+    let plans = plan_line(&line, cfg);
+    let (safe, j4) = (plans[3].1, plans[3].3.j());
+    assert!(
+        safe && j4 <= 1.005 * 13_886.7,
+        "track 4 (safe {safe}): J {j4} at {} m vs the best safe 13 886.7 at 1 018.86 m",
         plans[3].2
     );
 }

@@ -136,7 +136,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         );
         if let Some(t) = obj.tripped {
             fl.count = fl.count.saturating_add(obj.evaluations);
-            return self.answer_tripped(&mut fl, &s, t, obj.best_safe, &mut scan);
+            let (f, found) = self.answer_tripped(&mut fl, &s, t, obj.best_safe, &mut scan)?;
+            if let Some(c) = self.inward(&mut fl, (&s, &mut obj, &mut scan), (&f, t.0))? {
+                return Ok(c);
+            }
+            let iterations = self.work.iterations;
+            return Ok(self.single_candidate(f, found, (iterations, fl.count), s.h_safe));
         }
         first?;
         let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
@@ -286,7 +291,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// The answer when a constrained single track's optimizer left the
-    /// safe set at `t` (see [`single::tripped`]).
+    /// safe set at `t` (see [`single::tripped`]): the boundary's flight and
+    /// status.
     fn answer_tripped(
         &mut self,
         fl: &mut Flights<'_, '_, N>,
@@ -294,10 +300,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         t: (f32, f32),
         best_safe: Option<(f32, f32, f32)>,
         scan: &mut ScanLog,
-    ) -> Result<Candidate<N>, PlanError> {
+    ) -> Result<(Flown<N>, Found), PlanError> {
         let lo = s.bounds.lo.first().copied().unwrap_or(t.0);
         let hi = s.bounds.hi.first().copied().unwrap_or(t.0);
-        let (f, found) = single::tripped(
+        single::tripped(
             fl,
             t,
             best_safe,
@@ -306,9 +312,52 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             s.h_safe,
             (self.cfg.scan_points, self.cfg.bisection_steps),
             scan,
-        )?;
-        let iterations = self.work.iterations;
-        Ok(self.single_candidate(f, found, (iterations, fl.count), s.h_safe))
+        )
+    }
+
+    /// After a trip, when the optimizer only overshot: where `J` falls
+    /// from the boundary `f` into the safe set (away from the trip at
+    /// `z_bad`, a finite difference of `CHECK_STEP`), the optimum is
+    /// interior and the guarded optimizer runs once more from the boundary
+    /// (its steps only lower `J`); its candidate unless it trips again.
+    /// Unbudgeted calls only (the budgeted ones keep the boundary).
+    fn inward(
+        &mut self,
+        fl: &mut Flights<'_, '_, N>,
+        (s, obj, scan): (&Setup<K>, &mut PlanObjective<'_, N>, &mut ScanLog),
+        (f, z_bad): (&Flown<N>, f32),
+    ) -> Result<Option<Candidate<N>>, PlanError> {
+        let z_b = f.depth;
+        if self.budget.limit != u32::MAX || f.score.min_altitude() < s.h_safe {
+            return Ok(None);
+        }
+        let Ok((score, _)) = fl.fly(z_b + single::CHECK_STEP.copysign(z_b - z_bad)) else {
+            return Ok(None);
+        };
+        if score.j() >= f.score.j() || score.min_altitude() < s.h_safe {
+            return Ok(None);
+        }
+        let spent = obj.evaluations;
+        obj.tripped = None;
+        let mut z0 = self.work.z;
+        if let Some(z) = z0.first_mut() {
+            *z = z_b;
+        }
+        let run = (self.cfg.bfgs.first_step, self.cfg.bfgs.max_iterations);
+        let zero = [0.0; K];
+        let ran = self.optimize_onto(obj, &z0, &s.bounds, run, &zero, Merge::First);
+        if obj.tripped.is_some() || ran.is_err() {
+            fl.count = fl
+                .count
+                .saturating_add(obj.evaluations.saturating_sub(spent));
+            return Ok(None);
+        }
+        // (`finish` counts all of `obj`'s evaluations.)
+        fl.count = fl.count.saturating_sub(spent);
+        let last = obj.last_flight;
+        let answer = (self.work.iterations, None);
+        self.finish((fl, s, scan), (obj, last), answer, (obj.mu, 0))
+            .map(Some)
     }
 
     /// The call's horizon, first penalty weight, box and certified

@@ -18,7 +18,7 @@ use super::status::{Found, OptimizerStop};
 
 /// The finite-difference step, m, that checks a boundary optimum (`J` must
 /// not decrease into the safe set).
-const CHECK_STEP: f32 = 2.0;
+pub(super) const CHECK_STEP: f32 = 2.0;
 
 /// One end of a boundary bracket: a depth (m) and its minimum altitude
 /// (m) when known.

@@ -90,7 +90,7 @@ pub const TRACKWISE_K1: [TrackPlan; 5] = [
         min_altitude: f32::from_bits(0x42700ad2) /* 60.010567 */,
         objective: f32::from_bits(0x4852399a) /* 215270.4 */,
         iterations: 2,
-        evaluations: 9,
+        evaluations: 10,
         history_len: 3,
         history_hash: 0xf5798d5b,
         next_x: f32::from_bits(0x441c4285) /* 625.03937 */,
