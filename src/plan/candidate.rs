@@ -136,12 +136,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         );
         if let Some(t) = obj.tripped {
             fl.count = fl.count.saturating_add(obj.evaluations);
-            let (f, found) = self.answer_tripped(&mut fl, &s, t, obj.best_safe, &mut scan)?;
-            if let Some(c) = self.inward(&mut fl, (&s, &mut obj, &mut scan), (&f, t.0))? {
-                return Ok(c);
-            }
-            let iterations = self.work.iterations;
-            return Ok(self.single_candidate(f, found, (iterations, fl.count), s.h_safe));
+            return self.after_trip(&mut fl, (&s, &mut obj, &mut scan), t);
         }
         first?;
         let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
@@ -288,6 +283,26 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 Ok(None)
             }
         }
+    }
+
+    /// The candidate when a constrained single track's optimizer left the
+    /// safe set at `t` (depth, least altitude; m): the boundary next to it
+    /// ([`Planner::answer_tripped`]), or the interior optimum where the
+    /// optimizer only overshot ([`Planner::inward`]). Not inlined: the
+    /// boundary's flight stays off the horizon path's stack.
+    #[inline(never)]
+    fn after_trip(
+        &mut self,
+        fl: &mut Flights<'_, '_, N>,
+        (s, obj, scan): (&Setup<K>, &mut PlanObjective<'_, N>, &mut ScanLog),
+        t: (f32, f32),
+    ) -> Result<Candidate<N>, PlanError> {
+        let (f, found) = self.answer_tripped(fl, s, t, obj.best_safe, scan)?;
+        if let Some(c) = self.inward(fl, (s, obj, scan), (&f, t.0))? {
+            return Ok(c);
+        }
+        let iterations = self.work.iterations;
+        Ok(self.single_candidate(f, found, (iterations, fl.count), s.h_safe))
     }
 
     /// The answer when a constrained single track's optimizer left the

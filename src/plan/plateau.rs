@@ -27,7 +27,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// The single track's plateau escape (module docs), after the
     /// optimizer: from a plateau (gradient exactly zero), a restart from
     /// each of its edges within the box. Returns the iterations so far (a
-    /// restart counts one more).
+    /// restart counts one more). Not inlined: its state stays off the
+    /// horizon path's stack.
+    #[inline(never)]
     pub(super) fn escape_plateau_single(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
