@@ -13,6 +13,7 @@
 
 pub mod armijo;
 pub mod bfgs;
+pub(crate) mod constrained;
 pub(crate) mod dense;
 pub mod gd;
 pub(crate) mod qp;

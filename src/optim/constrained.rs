@@ -1,0 +1,87 @@
+//! The interface between a constrained objective and the SQP
+//! ([`super::sqp`]): what the objective's linearization at a point holds
+//! (`J`, its gradient, the constraint rows and the Gauss–Newton matrix)
+//! and the trait it implements.
+
+use super::dense::Mat;
+
+/// Most constraint rows an objective gives (the rest of the QP's rows are
+/// the box's).
+pub(crate) const CONSTRAINTS: usize = 32;
+
+/// An objective's linearization at a point: `J`, its gradient, and the
+/// constraint rows `cᵢ >= 0` with their gradients, in the same order at
+/// every point (for the planner: one per segment, grouped by track), the
+/// rows' storage laid out for the objective to fill in place.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Linearized<const K: usize> {
+    /// `J`, m³.
+    pub j: f32,
+    /// `∇J`, m².
+    pub grad: [f32; K],
+    /// ℓ1 infeasibility `v`, m.
+    pub infeasibility: f32,
+    /// Rows used.
+    pub rows: usize,
+    /// Each row's `c`, m (`+inf`: no constraint there).
+    pub c: [f32; CONSTRAINTS],
+    /// Each row's gradient, m/m.
+    pub a: [[f32; K]; CONSTRAINTS],
+    /// Each row's group (for the planner: the track).
+    pub group: [u8; CONSTRAINTS],
+    /// Rows with `c` above this (m) stay out of the QP: too far from
+    /// active for their linearization to matter.
+    pub band: f32,
+    /// The Gauss–Newton matrix of `J` (m), when asked for.
+    pub gn: Mat<K>,
+}
+
+impl<const K: usize> Default for Linearized<K> {
+    fn default() -> Self {
+        Self {
+            j: f32::INFINITY,
+            grad: [0.0; K],
+            infeasibility: 0.0,
+            rows: 0,
+            c: [f32::INFINITY; CONSTRAINTS],
+            a: [[0.0; K]; CONSTRAINTS],
+            group: [0; CONSTRAINTS],
+            band: f32::INFINITY,
+            gn: [[0.0; K]; K],
+        }
+    }
+}
+
+impl<const K: usize> Linearized<K> {
+    /// `(c, ∇c, group)` of the rows used.
+    pub(super) fn iter(&self) -> impl Iterator<Item = (f32, &[f32; K], u8)> + '_ {
+        self.c
+            .iter()
+            .zip(self.a.iter())
+            .zip(self.group.iter())
+            .take(self.rows)
+            .map(|((&c, a), &g)| (c, a, g))
+    }
+}
+
+/// A constrained objective.
+pub(crate) trait Constrained<const K: usize> {
+    /// Why an evaluation failed.
+    type Error;
+    /// The linearization at `z` into `out` (with the Gauss–Newton matrix
+    /// when `gn`).
+    ///
+    /// # Errors
+    /// When the objective cannot be evaluated at `z`.
+    fn linearize(
+        &mut self,
+        z: &[f32; K],
+        gn: bool,
+        out: &mut Linearized<K>,
+    ) -> Result<(), Self::Error>;
+    /// `(J, v)` at `z` alone (m³, m).
+    ///
+    /// # Errors
+    /// As [`Constrained::linearize`].
+    fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Self::Error>;
+}
