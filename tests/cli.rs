@@ -997,3 +997,43 @@ fn progress_on_stderr_for_long_runs() {
         .unwrap();
     assert!(quiet.stderr.is_empty());
 }
+
+/// A line that flies into the rock does not give up on the tracks after
+/// it: the track that starts below the bottom is flown at the shallowest
+/// depth (reported infeasible, after the crash), and the next track is
+/// planned from where that climb leaves the vehicle. A random line of
+/// `tools/reference/check_planner.py --seed 23` (`unseen_23_0`): tracks 1
+/// and 2 cannot be made safe, and the f64 checker's best safe depth of
+/// track 3 from the state the climb reaches is 140.21 m (1.796e6 m³).
+#[test]
+fn a_crash_does_not_end_the_planning() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
+    let (p, w) = (
+        format!("{dir}/crash_recover.csv"),
+        format!("{dir}/crash_recover.waypoints.csv"),
+    );
+    let v = json_of(&[
+        "--profile",
+        &p,
+        "--waypoints",
+        &w,
+        "--mode",
+        "track",
+        "--json",
+    ]);
+    let tracks = v["tracks"].as_array().unwrap();
+    assert_eq!(tracks[1]["status"], "infeasible");
+    assert_eq!(
+        tracks[1]["evaluations"], 0,
+        "track 2 starts below the bottom"
+    );
+    let t3 = &tracks[2];
+    assert_eq!(t3["safe"], true, "{t3}");
+    assert!(t3["evaluations"].as_u64().unwrap() > 0);
+    let j3 = t3["J"].as_f64().unwrap();
+    assert!(
+        j3 <= 1.005 * 1.796_27e6,
+        "track 3: J {j3} vs the best safe 1.79627e6"
+    );
+    assert!(v["safe"] == false, "the line as a whole is not safe");
+}

@@ -421,20 +421,38 @@ fn plan_line(
         progress.step("planning track", n + 1, tracks);
         let p = match planner.plan(scenario, &state, n) {
             Ok(p) => p,
-            // An infeasible line may fly into the rock before the end: the
-            // tracks after it have no start to plan from. They are flown
-            // at the shallowest allowed depth and reported infeasible.
+            // An infeasible line may fly into the rock before the end: a
+            // track that starts below the bottom has no start to plan
+            // from. It is flown at the shallowest allowed depth (the
+            // climb) and reported infeasible, and planning goes on from
+            // where the climb leaves the vehicle (above the bottom again,
+            // or the next track climbs too).
             Err(PlanError::StartBelowBottom) if n > 0 => {
                 let shallow = scenario.mission().depth_limits()[0];
-                for _ in n..tracks {
-                    depths.push(shallow);
-                    optimizer.push(Effort {
-                        status: "infeasible",
-                        after_crash: true,
-                        ..Effort::fixed()
-                    });
+                depths.push(shallow);
+                optimizer.push(Effort {
+                    status: "infeasible",
+                    after_crash: true,
+                    ..Effort::fixed()
+                });
+                let mut score = [auvnav::TrackScore::default()];
+                match scenario.simulate(&state, n, &[shallow], &mut score, |_| {}) {
+                    Ok(next) => {
+                        state = next;
+                        continue;
+                    }
+                    Err(_) => {
+                        for _ in n + 1..tracks {
+                            depths.push(shallow);
+                            optimizer.push(Effort {
+                                status: "infeasible",
+                                after_crash: true,
+                                ..Effort::fixed()
+                            });
+                        }
+                        break;
+                    }
                 }
-                break;
             }
             Err(e) => return Err(Fail::input(format!("planning track {}: {e}", n + 1))),
         };
