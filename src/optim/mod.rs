@@ -282,6 +282,29 @@ impl<const K: usize> Outcome<K> {
         }
     }
 
+    /// Where this outcome stands, for [`Outcome::restore`] to put back
+    /// after a run that is not kept.
+    pub(crate) fn mark(&self) -> Mark<K> {
+        Mark {
+            z: self.z,
+            j: self.j,
+            gradient: self.gradient,
+            grad_norm: self.grad_norm,
+            status: self.status,
+            counts: (self.iterations, self.evaluations, self.skipped_updates),
+            history: self.history.len(),
+        }
+    }
+
+    /// Back to `mark`: every field as it was, the history truncated back
+    /// to its length then (a run not kept leaves no trace).
+    pub(crate) fn restore(&mut self, mark: &Mark<K>) {
+        (self.z, self.j, self.gradient) = (mark.z, mark.j, mark.gradient);
+        (self.grad_norm, self.status) = (mark.grad_norm, mark.status);
+        (self.iterations, self.evaluations, self.skipped_updates) = mark.counts;
+        self.history.truncate(mark.history);
+    }
+
     /// This outcome made [`Outcome::at`] `z` in place (no temporary of
     /// the history's size on the stack).
     pub(crate) fn reset_at(&mut self, z: &[f32; K]) {
@@ -295,6 +318,20 @@ impl<const K: usize> Outcome<K> {
         self.skipped_updates = 0;
         self.history.clear();
     }
+}
+
+/// An [`Outcome`] as it stood ([`Outcome::mark`]), its history by length.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Mark<const K: usize> {
+    z: [f32; K],
+    /// The objective then.
+    pub(crate) j: f32,
+    gradient: [f32; K],
+    grad_norm: f32,
+    status: Status,
+    /// Iterations, evaluations, skipped updates.
+    counts: (u32, u32, u32),
+    history: usize,
 }
 
 /// An optimizer setting out of range.

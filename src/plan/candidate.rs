@@ -352,7 +352,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if score.j() >= f.score.j() || score.min_altitude() < s.h_safe {
             return Ok(None);
         }
-        let spent = obj.evaluations;
+        // (The first run's flights are in `fl.count` already; unbudgeted,
+        // `obj` has no limit to keep.)
+        obj.evaluations = 0;
         obj.tripped = None;
         let mut z0 = self.work.z;
         if let Some(z) = z0.first_mut() {
@@ -362,13 +364,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let zero = [0.0; K];
         let ran = self.optimize_onto(obj, &z0, &s.bounds, run, &zero, Merge::First);
         if obj.tripped.is_some() || ran.is_err() {
-            fl.count = fl
-                .count
-                .saturating_add(obj.evaluations.saturating_sub(spent));
+            fl.count = fl.count.saturating_add(obj.evaluations);
             return Ok(None);
         }
-        // (`finish` counts all of `obj`'s evaluations.)
-        fl.count = fl.count.saturating_sub(spent);
         let last = obj.last_flight;
         let answer = (self.work.iterations, None);
         self.finish((fl, s, scan), (obj, last), answer, (obj.mu, 0))

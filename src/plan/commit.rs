@@ -45,6 +45,20 @@ pub(super) struct Chosen<const N: usize> {
     pub(super) previous: bool,
 }
 
+impl<const N: usize> Chosen<N> {
+    /// The continuation `depths` (`len` tracks) with its certificate,
+    /// neither searched for nor the previous one.
+    pub(super) fn new(depths: [f32; MAX_TRACKS], len: usize, cert: Certificate) -> Self {
+        Self {
+            depths,
+            len,
+            cert,
+            searched: false,
+            previous: false,
+        }
+    }
+}
+
 /// A later call keeps the previous continuation, whose certificate it
 /// knows, unless the candidate lowers the line's `J` (the tracks committed
 /// so far and the horizon) by more than this share: re-certifying costs a
@@ -131,13 +145,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut depths = [0.0; MAX_TRACKS];
         depths[0] = cand.flown.depth;
         let at = (f32::NEG_INFINITY, flights);
-        Ok(Chosen {
-            depths,
-            len: 1,
-            cert: self.certify_one(sc, bottom, (state, &cand.flown), at),
-            searched: false,
-            previous: false,
-        })
+        let cert = self.certify_one(sc, bottom, (state, &cand.flown), at);
+        Ok(Chosen::new(depths, 1, cert))
     }
 
     /// The previous call's continuation with its certificate, known
@@ -190,11 +199,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             id: 0,
         };
         (cert.all >= cand.h_safe).then_some(Chosen {
-            depths,
-            len,
-            cert,
-            searched: false,
             previous: true,
+            ..Chosen::new(depths, len, cert)
         })
     }
 
@@ -217,13 +223,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let horizon = (&self.work.z, self.horizon_len);
         let c = self.candidate_continuation((track, len), (cand.flown.depth, horizon), shallow);
         let cert_c = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
-        let candidate = Chosen {
-            depths: c,
-            len,
-            cert: cert_c,
-            searched: false,
-            previous: false,
-        };
+        let candidate = Chosen::new(c, len, cert_c);
         if cert_c.all >= cand.h_safe {
             return Ok(candidate);
         }
@@ -232,13 +232,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // avoid, while the committed depth alone need not.
         let (c2, cert_c2) = self.then_climb(sc, bottom, cand, ((&c, cert_c), len), flights);
         if cert_c2.all >= cand.h_safe {
-            return Ok(Chosen {
-                depths: c2,
-                len,
-                cert: cert_c2,
-                searched: false,
-                previous: false,
-            });
+            return Ok(Chosen::new(c2, len, cert_c2));
         }
         let (c, cert_c) = if cert_c2.all > cert_c.all {
             (c2, cert_c2)
@@ -260,15 +254,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if cert_a.all >= cand.h_safe {
                 let ends = ((&a, cert_a), (&c, cert_c));
                 let found = self.search(sc, bottom, ends, len, cand.h_safe, flights);
-                return Ok(self.search_committed(sc, bottom, found, (&c, len), cand, flights));
+                return Ok(self.search_committed(sc, bottom, found, cand, flights));
             }
             if cert_a.all > best.cert.all {
                 best = Chosen {
-                    depths: a,
-                    len,
-                    cert: cert_a,
                     searched: true,
-                    previous: false,
+                    ..Chosen::new(a, len, cert_a)
                 };
             }
         }

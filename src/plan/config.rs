@@ -50,9 +50,10 @@ pub struct PlannerConfig {
     /// single track and the scan's `J + μ V`; a horizon under BFGS is an
     /// SQP, without a penalty in its objective.
     pub penalty_weight: f32,
-    /// Penalty stages (gradient descent, a single track): each re-solves with `μ` ×100
-    /// while the optimum still violates. ≥ 1. Default 2 (μ up to 1e6). A warm-started call starts
-    /// at the `μ` the previous call ended with.
+    /// Penalty stages (gradient descent, a single track): each re-solves
+    /// with `μ` ×100 while the optimum still violates. ≥ 1. Default 2 (μ
+    /// up to 1e6). A warm-started call starts at the `μ` the previous call
+    /// ended with.
     pub penalty_stages: u32,
     /// Penalty margin `m_p` above `h_a` for horizons of two tracks or
     /// more, m (a single track is not penalized: its boundary search finds

@@ -84,9 +84,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         bounds: &Bounds<K>,
         run: (f32, u32),
     ) -> Result<Option<u32>, PlanError> {
-        let w = &self.work;
-        let kept = (w.z, w.j, w.gradient, w.grad_norm, w.status);
-        let counts = (w.iterations, w.skipped_updates, w.history.len());
+        let kept = self.work.mark();
         let guard = obj.guard.take();
         let zero = [0.0; K];
         let taken = self.optimize_onto(obj, start, bounds, run, &zero, Merge::IfBetter);
@@ -105,10 +103,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if safe == Some(true) {
             return Ok(Some(taken));
         }
-        let w = &mut self.work;
-        (w.z, w.j, w.gradient, w.grad_norm, w.status) = kept;
-        (w.iterations, w.skipped_updates) = (counts.0, counts.1);
-        w.history.truncate(counts.2);
+        self.work.restore(&kept);
         Ok(None)
     }
 }

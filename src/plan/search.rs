@@ -98,17 +98,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
             bad = (t, cert.all - h_safe);
         }
+        let depths = if good.0 > 0.0 { at(good.0) } else { *a };
         Chosen {
-            depths: if good.0 > 0.0 { at(good.0) } else { *a },
-            len,
-            cert: good.1,
             searched: true,
-            previous: false,
+            ..Chosen::new(depths, len, good.1)
         }
     }
 
     /// A second leg after [`Planner::search`] stopped short of the
-    /// candidate `c`: from the point found, the committed depth alone
+    /// candidate: from the point found, the committed depth alone
     /// towards the candidate's, the later depths held (the straight path
     /// moves them all, and a later depth is often what stopped it, while
     /// the next call re-plans the later tracks anyway). Monterey 1 with a
@@ -118,16 +116,17 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
         found: Chosen<N>,
-        (c, len): (&[f32; MAX_TRACKS], usize),
         cand: &Candidate<N>,
         flights: &mut u32,
     ) -> Chosen<N> {
-        let (Some(&from), Some(&to)) = (found.depths.first(), c.first()) else {
-            return found;
-        };
+        let (to, len) = (cand.flown.depth, found.len);
         // With a horizon of one track the candidate's depth is myopic (it
         // never saw the next track): only the straight path then.
-        if !found.searched || from.to_bits() == to.to_bits() || len < 2 || self.horizon_len < 2 {
+        let reached = found
+            .depths
+            .first()
+            .is_none_or(|z| z.to_bits() == to.to_bits());
+        if reached || len < 2 || self.horizon_len < 2 {
             return found;
         }
         let mut target = found.depths;

@@ -207,9 +207,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         iterations: u32,
     ) -> Option<u32> {
-        let acc = &self.work;
-        let kept = (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status);
-        let kept_counts = (acc.iterations, acc.evaluations, acc.history.len());
+        let kept = self.work.mark();
         let kept_v = obj.last_violation;
         let left = BfgsConfig {
             max_iterations: self
@@ -238,15 +236,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             && if kept_v > tol {
                 v < kept_v
             } else {
-                v <= tol && acc.j.partial_cmp(&kept.1) == Some(core::cmp::Ordering::Less)
+                v <= tol && acc.j.partial_cmp(&kept.j) == Some(core::cmp::Ordering::Less)
             };
         if better {
             return Some(iterations.saturating_add(acc.iterations).saturating_add(1));
         }
         obj.last_violation = kept_v;
-        (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
-        (acc.iterations, acc.evaluations) = (kept_counts.0, kept_counts.1);
-        acc.history.truncate(kept_counts.2);
+        acc.restore(&kept);
         None
     }
 
@@ -515,15 +511,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         merge: Merge,
     ) -> Result<Option<u32>, PlanError> {
         let acc = &mut self.work;
-        // What a rejected restart restores (all but the history, which is
-        // truncated back).
-        let kept = (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status);
-        let kept_counts = (
-            acc.iterations,
-            acc.evaluations,
-            acc.skipped_updates,
-            acc.history.len(),
-        );
+        // What a rejected restart restores.
+        let kept = acc.mark();
         if let Merge::First = merge {
             acc.history.clear();
         }
@@ -559,12 +548,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             run.map_err(start_error)?;
         }
         // (A NaN objective is not better either.)
-        let worse = acc.j.partial_cmp(&kept.1) != Some(core::cmp::Ordering::Less);
+        let worse = acc.j.partial_cmp(&kept.j) != Some(core::cmp::Ordering::Less);
         if unstarted || (matches!(merge, Merge::IfBetter) && worse) {
-            (acc.z, acc.j, acc.gradient, acc.grad_norm, acc.status) = kept;
-            (acc.iterations, acc.evaluations, acc.skipped_updates) =
-                (kept_counts.0, kept_counts.1, kept_counts.2);
-            acc.history.truncate(kept_counts.3);
+            acc.restore(&kept);
             return Ok(None);
         }
         Ok(Some(acc.iterations))

@@ -146,23 +146,32 @@ impl<'a, const K: usize> Watch<'a, K> {
 
     /// One end at `x` with `e` and the columns' `∂e` (`hi`: the second).
     fn end(&mut self, slot: usize, (x, e): (f32, f32), de: &[(f32, f32); K], hi: bool) {
-        let Some(s) = self.segment(slot, x) else {
+        let Some(g) = self.new_least(slot, (x, e)) else {
             return;
         };
-        let h = e + self.h_r;
-        let (Some(m), Some(g)) = (self.min.get_mut(s), self.grad.get_mut(s)) else {
-            return;
-        };
-        if h < *m {
-            *m = h;
-            for (j, (gj, d)) in g.iter_mut().zip(de.iter()).enumerate() {
-                *gj = match (j <= slot, hi) {
-                    (false, _) => 0.0,
-                    (true, true) => d.1,
-                    (true, false) => d.0,
-                };
-            }
+        for (j, (gj, d)) in g.iter_mut().zip(de.iter()).enumerate() {
+            *gj = match (j <= slot, hi) {
+                (false, _) => 0.0,
+                (true, true) => d.1,
+                (true, false) => d.0,
+            };
         }
+    }
+
+    /// A sample at `x` with `e` (m) on track `slot`: when it sets its
+    /// segment's least altitude, the altitude is recorded and the
+    /// segment's gradient row returned for the caller to write.
+    #[inline(always)]
+    fn new_least(&mut self, slot: usize, (x, e): (f32, f32)) -> Option<&mut [f32; K]> {
+        let s = self.segment(slot, x)?;
+        let h = e + self.h_r;
+        let m = self.min.get_mut(s)?;
+        // (Strictly lower: a NaN records nothing.)
+        if h.partial_cmp(m) != Some(core::cmp::Ordering::Less) {
+            return None;
+        }
+        *m = h;
+        self.grad.get_mut(s)
     }
 
     /// Whether a piece starting at `lo` (m) needs only its upper end
@@ -182,14 +191,7 @@ impl<'a, const K: usize> Watch<'a, K> {
     #[inline(always)]
     pub(super) fn upper(&mut self, slot: usize, (x, e): (f32, f32)) -> Option<&mut [f32; K]> {
         self.last = x;
-        let s = self.segment(slot, x)?;
-        let h = e + self.h_r;
-        let m = self.min.get_mut(s)?;
-        if h >= *m {
-            return None;
-        }
-        *m = h;
-        let g = self.grad.get_mut(s)?;
+        let g = self.new_least(slot, (x, e))?;
         for gj in g.iter_mut().skip(slot.saturating_add(1)) {
             *gj = 0.0;
         }
