@@ -459,6 +459,28 @@ fn an_overshoot_into_the_unsafe_set_returns_to_the_interior_optimum() {
     );
 }
 
+/// A horizon whose SQP stopped at a one-sided kink leaves it: on a random
+/// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 23`,
+/// `unseen_23_1`, h_r/h_a 80/60) track 2's least altitude is set where its
+/// pitch reference has been saturated in a dive since the track began, so
+/// `z_2`'s column is exactly zero there and the row blocked `z_1` (934.2 m;
+/// the line's `J` 2.736e6 m³, 1.64× the f64 beam search's best safe plan,
+/// 1.669e6 m³ at 961.7, 1 087.1, 850.0, 883.2 m).
+#[test]
+fn a_horizon_leaves_a_one_sided_kink() {
+    let line = fixture_line("kink_horizon");
+    let plans = plan_line(&line, PlannerConfig::default());
+    let total: f32 = plans.iter().map(|p| p.3.j()).sum();
+    let least = plans
+        .iter()
+        .map(|p| p.3.min_altitude())
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        least >= 60.0 && total <= 1.02 * 1.669_35e6,
+        "J {total} (least altitude {least} m) vs the best safe 1.669 35e6"
+    );
+}
+
 #[test]
 fn warm_start_makes_later_calls_cheap() {
     let line = Line::real("us_monterey_canyon_2");

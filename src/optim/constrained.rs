@@ -62,6 +62,24 @@ impl<const K: usize> Linearized<K> {
             .take(self.rows)
             .map(|((&c, a), &g)| (c, a, g))
     }
+
+    /// The group of the first row that binds at a one-sided kink, if any:
+    /// active (`c <= active`, m), of a group `g` in `1..n` whose own
+    /// column `∂c/∂z_g` is exactly zero while an earlier one is not. For
+    /// the planner that is a later track's least altitude set while its
+    /// pitch reference has stayed saturated since the track began: its
+    /// own depth moves it only one way (a shallower dive unsaturates
+    /// sooner and lifts the sample; a deeper one changes nothing there),
+    /// and the linearization shows the side that does nothing, so the
+    /// earlier depths look blocked by a row the later depth could free.
+    pub(crate) fn kinked(&self, active: f32, n: usize) -> Option<usize> {
+        self.iter().find_map(|(c, a, g)| {
+            let g = usize::from(g);
+            let own = a.get(g).copied()?;
+            let earlier = a.get(..g)?.iter().any(|&v| v != 0.0);
+            (c <= active && g >= 1 && g < n && own == 0.0 && earlier).then_some(g)
+        })
+    }
 }
 
 /// A constrained objective.
@@ -84,4 +102,35 @@ pub(crate) trait Constrained<const K: usize> {
     /// # Errors
     /// As [`Constrained::linearize`].
     fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Self::Error>;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows `(c, ∂c/∂z, group)` of a three-depth linearization.
+    fn lin(rows: &[(f32, [f32; 3], u8)]) -> Linearized<3> {
+        let mut l = Linearized::<3>::default();
+        for (i, &(c, a, g)) in rows.iter().enumerate() {
+            l.c[i] = c;
+            l.a[i] = a;
+            l.group[i] = g;
+        }
+        l.rows = rows.len();
+        l
+    }
+
+    #[test]
+    fn a_kink_is_an_active_later_row_blind_to_its_own_depth() {
+        // Track 2's row: active, its own column zero, track 1's not.
+        let kinked = (0.01, [-0.4, 0.0, 0.0], 1);
+        assert_eq!(lin(&[(3.0, [0.5, 0.0, 0.0], 0), kinked]).kinked(0.1, 3), Some(1));
+        // Not active; its own column moves it; the first track's; no
+        // earlier column; a group past the horizon's `n`.
+        assert_eq!(lin(&[(0.5, [-0.4, 0.0, 0.0], 1)]).kinked(0.1, 3), None);
+        assert_eq!(lin(&[(0.01, [-0.4, -0.2, 0.0], 1)]).kinked(0.1, 3), None);
+        assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 0)]).kinked(0.1, 3), None);
+        assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 2)]).kinked(0.1, 3), None);
+        assert_eq!(lin(&[kinked]).kinked(0.1, 1), None);
+    }
 }

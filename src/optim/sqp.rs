@@ -75,8 +75,8 @@ const RESTORED: f32 = 0.5;
 /// may be infeasible, and lower). `metric`: the first metric when given
 /// (a restart near a finished run keeps its curvature), else the
 /// Gauss–Newton matrix at `z0`; the final metric on return. Returns the
-/// ℓ1 merit's final penalty weight `ρ` (m³ of `J` per m of `v`; 0 when no
-/// constraint was ever active).
+/// ℓ1 merit's final penalty weight and any row active at a one-sided kink
+/// at the end ([`SqpEnd`]).
 ///
 /// # Errors
 /// [`OptimError`] when the objective fails or is not finite at the start.
@@ -87,7 +87,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     cfg: &BfgsConfig,
     feas_tol: f32,
     out: &mut Outcome<K>,
-) -> Result<f32, OptimError<O::Error>> {
+) -> Result<SqpEnd, OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
     if !bounds.is_valid() {
         return Err(OptimError::Config(super::OptimConfigError::Bounds));
@@ -143,7 +143,32 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     out.evaluations = run.evaluations;
     out.skipped_updates = run.skipped;
     *metric = Some(run.a);
-    Ok(run.rho)
+    Ok(SqpEnd {
+        rho: run.rho,
+        kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
+    })
+}
+
+/// What a run leaves beside its [`Outcome`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SqpEnd {
+    /// The ℓ1 merit's final penalty weight `ρ` (m³ of `J` per m of `v`;
+    /// 0 when no constraint was ever active).
+    pub rho: f32,
+    /// The group of a row active at a one-sided kink at the end
+    /// ([`Linearized::kinked`]), if any.
+    pub kink: Option<usize>,
+}
+
+/// How close to zero (m) a row's `c` counts as active at the end: the
+/// feasibility tolerance, or a hundredth of the band of rows the QP takes.
+fn kink_band<const K: usize>(lin: &Linearized<K>, feas_tol: f32) -> f32 {
+    let band = if lin.band.is_finite() {
+        0.01 * lin.band
+    } else {
+        0.0
+    };
+    feas_tol.max(band)
 }
 
 /// The state of one SQP run.

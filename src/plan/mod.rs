@@ -141,6 +141,7 @@ mod config;
 mod fallback;
 mod flights;
 mod gaps;
+mod kink;
 mod objective;
 mod planner;
 mod plateau;

@@ -159,7 +159,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             self.work.reset_at(z0);
             return Ok((0, 0));
         }
-        let rho = run.map_err(start_error)?;
+        let end = run.map_err(start_error)?;
+        let rho = end.rho;
         let mut iterations = self.work.iterations;
         let mut scanned = 0_u64;
         for _ in 0..PLATEAU_ROUNDS {
@@ -191,6 +192,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 None => break,
             }
         }
+        if let Some(g) = end.kink
+            && iterations < self.cfg.bfgs.max_iterations
+        {
+            iterations = self.leave_kink(obj, (h, bounds), (g, tol), iterations);
+        }
         self.work.iterations = iterations;
         Ok((iterations, scanned | skip))
     }
@@ -199,7 +205,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// ends better than the workspace's: feasible and lower, or, from an
     /// infeasible optimum, less infeasible. Returns the iterations so far
     /// when kept.
-    fn sqp_restart(
+    pub(super) fn sqp_restart(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         z: &[f32; K],
