@@ -124,7 +124,10 @@ mod tests {
     fn a_kink_is_an_active_later_row_blind_to_its_own_depth() {
         // Track 2's row: active, its own column zero, track 1's not.
         let kinked = (0.01, [-0.4, 0.0, 0.0], 1);
-        assert_eq!(lin(&[(3.0, [0.5, 0.0, 0.0], 0), kinked]).kinked(0.1, 3), Some(1));
+        assert_eq!(
+            lin(&[(3.0, [0.5, 0.0, 0.0], 0), kinked]).kinked(0.1, 3),
+            Some(1)
+        );
         // Not active; its own column moves it; the first track's; no
         // earlier column; a group past the horizon's `n`.
         assert_eq!(lin(&[(0.5, [-0.4, 0.0, 0.0], 1)]).kinked(0.1, 3), None);

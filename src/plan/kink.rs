@@ -16,6 +16,10 @@ use crate::optim::Bounds;
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
 
+/// The share of `h_r − h_a` by which the moved depth must lift its
+/// track's least altitude above the track's target for the restart.
+const LIFT: f32 = 0.05;
+
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The escape of the module docs from the kink of track `g` of the
     /// horizon (index in the call's horizon), feasible within `tol` (m).
@@ -55,13 +59,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let (_, at_g) = obj.head(&z, g)?;
         let dive = zg - at_g.depth();
         let m = obj.sc.mission();
-        let shift = crate::num::min(m.reference_altitude() - m.min_altitude(), 0.5 * dive);
+        let band = m.reference_altitude() - m.min_altitude();
+        let shift = crate::num::min(band, 0.5 * dive);
         // (NaN, from a diverged head, moves nothing either.)
         if shift.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
             return Ok(None);
         }
+        let up = crate::num::max(zg - shift, lo);
+        // Only where the shallower dive lifts the track's least altitude
+        // clear of its target (the row was at it): where the dive stays
+        // saturated past that sample (Monterey 2's later calls), the
+        // restart would only find the same optimum again.
+        let least = obj.least_of_track(&at_g, g, up)?;
+        let bar = obj.target_of(g) + LIFT * band;
+        if least.partial_cmp(&bar) != Some(core::cmp::Ordering::Greater) {
+            return Ok(None);
+        }
         if let Some(v) = z.get_mut(g) {
-            *v = crate::num::max(zg - shift, lo);
+            *v = up;
         }
         Ok(Some(z))
     }

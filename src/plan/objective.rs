@@ -114,7 +114,7 @@ impl<const N: usize> PlanObjective<'_, N> {
     }
 
     /// The SQP's target altitude of track `t` of the horizon, m.
-    fn target_of(&self, t: usize) -> f32 {
+    pub(super) fn target_of(&self, t: usize) -> f32 {
         let base = if t == 0 { self.target.0 } else { self.target.1 };
         base + self.gaps.get(t).map_or(0.0, Cell::get)
     }
@@ -189,6 +189,23 @@ impl<const N: usize> PlanObjective<'_, N> {
             .fly(at_j, self.track.saturating_add(j), used, tail)
             .map_err(Stop::Sim)?;
         self.value_of(&scores)
+    }
+
+    /// Track `j` of the horizon alone flown at depth `zj` (m) from `at_j`,
+    /// the state it starts in: its least altitude, m. One flight, counted.
+    pub fn least_of_track(
+        &mut self,
+        at_j: &VehicleState<N>,
+        j: usize,
+        zj: f32,
+    ) -> Result<f32, Stop> {
+        self.count_flight()?;
+        let mut score = [TrackScore::default()];
+        self.sc
+            .fly(at_j, self.track.saturating_add(j), &[zj], &mut score)
+            .map_err(Stop::Sim)?;
+        let [flown] = score;
+        Ok(flown.min_altitude())
     }
 
     /// `(Σ J, v)` of the horizon's `scores` (m³, m): a non-finite `J` is
