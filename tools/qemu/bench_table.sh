@@ -133,7 +133,7 @@ END {
   print ""
   print "| against the targets | measured | target |"
   print "|---|---:|---|"
-  printf "| instructions per simulated step | %s | <= 150 |\n", group(step)
+  printf "| instructions per simulated step | %s | <= 120 |\n", group(step)
   printf "| track-wise solve of the steepest track (%s, %.1f deg) | %s | <= 10 000 000 |\n", "track " substr(steep, 4), steep_deg, group(count[steep] - over)
   printf "| stack high-water mark of one solve, track-wise (Planner::<1>), worst track | %s | <= 8 KiB |\n", kib(tw_stack)
   printf "| stack high-water mark of one solve, horizon (Planner::<5>), worst call | %s | <= 8 KiB |\n", hz_stack ? kib(hz_stack) : "not run"
