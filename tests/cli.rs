@@ -1037,3 +1037,35 @@ fn a_crash_does_not_end_the_planning() {
     );
     assert!(v["safe"] == false, "the line as a whole is not safe");
 }
+
+/// The last call of a horizon (one track, warm-started from the
+/// continuation) whose penalized optimum dives below the floor answers
+/// with the boundary next to its safe warm start: on a random canyon line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 41`, `unseen_41_5`)
+/// the general fallback took the scanned safe depth nearest that optimum
+/// (223.3 m, least altitude −1.5 m), 68.8 m, with `J_5` 5.71e6 m³. With the
+/// first four tracks at the tool's depths (asserted: the premise), the f64
+/// reference (`auvref.evaluate_plan`, `z_5` scanned every 5 cm) finds the
+/// best safe `J_5` 2.319 15e6 m³ at 137.15 m (least altitude 60.004 m).
+#[test]
+fn a_warm_last_track_stays_by_its_boundary() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
+    let (p, w) = (
+        format!("{dir}/warm_last.csv"),
+        format!("{dir}/warm_last.waypoints.csv"),
+    );
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let tracks = v["tracks"].as_array().unwrap();
+    let head = [110.21864, 147.11755, 141.34277, 169.78854];
+    for (t, z) in tracks.iter().zip(head) {
+        let d = t["depth"].as_f64().unwrap();
+        assert!((d - z).abs() < 0.01, "depth {d} against the premise {z}");
+    }
+    let t5 = &tracks[4];
+    let j5 = t5["J"].as_f64().unwrap();
+    assert_eq!(t5["safe"], true, "{t5}");
+    assert!(
+        j5 <= 1.01 * 2.319_15e6,
+        "track 5: J {j5} vs the best safe 2.319 15e6 at 137.15 m"
+    );
+}

@@ -11,7 +11,7 @@ use crate::optim::Bounds;
 use crate::sim::{Scenario, TrackScore, VehicleState};
 
 use super::certify::Certificate;
-use super::fallback::{Flown, fallback};
+use super::fallback::{Flown, fallback, from_warm};
 use super::flights::Flights;
 use super::objective::PlanObjective;
 use super::planner::Warm;
@@ -484,6 +484,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         if !self.cfg.constrained || score.min_altitude() >= s.h_safe {
             return Ok((flown, Found::Optimized(stop)));
+        }
+        let warm = s.warm.and_then(|w| w.depths.first().copied());
+        if let (1, Some(z0)) = (s.h, warm) {
+            let alt = score.min_altitude();
+            let steps = self.cfg.bisection_steps;
+            if let Some(f) = from_warm(fl, z0, (z_opt, alt), s.h_safe, steps)? {
+                return Ok((f, Found::Boundary(stop)));
+            }
         }
         let lo = s.bounds.lo.first().copied().unwrap_or(z_opt);
         let hi = s.bounds.hi.first().copied().unwrap_or(z_opt);

@@ -77,6 +77,39 @@ pub(super) fn boundary<const N: usize>(
     })
 }
 
+/// A warm-started single track (the last of a horizon) whose optimum
+/// `(z_opt, alt_opt)` (m, m) fell below `h_safe`: the boundary between the
+/// warm start `z0` (the continuation's depth, which the previous call
+/// certified) and that optimum, when `z0` flies safe here. The general
+/// fallback picks the scanned safe depth nearest the optimum instead,
+/// which on a hinge (the least altitude flat on one side, falling slowly
+/// on the other) can lie far beyond the boundary: on a random canyon line
+/// (`check_planner.py --seed 41`, `unseen_41_5`) the last track went from
+/// its safe 136.95 m to 68.8 m, its `J` 2.33e6 to 5.71e6 m³.
+pub(super) fn from_warm<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    z0: f32,
+    (z_opt, alt_opt): (f32, f32),
+    h_safe: f32,
+    steps: u32,
+) -> Result<Option<Flown<N>>, PlanError> {
+    if z0.to_bits() == z_opt.to_bits() {
+        return Ok(None);
+    }
+    let (s0, _) = fl.fly(z0)?;
+    if s0.min_altitude() < h_safe {
+        return Ok(None);
+    }
+    let b = boundary(
+        fl,
+        (z0, Some(s0.min_altitude())),
+        (z_opt, Some(alt_opt)),
+        h_safe,
+        steps,
+    )?;
+    Ok((b.at.score.min_altitude() >= h_safe).then_some(b.at))
+}
+
 /// The safe depth closest to `z_opt` in `[lo, hi]` (flagged safe), or the
 /// safest depth when none is safe.
 #[allow(clippy::too_many_arguments)]
