@@ -38,6 +38,10 @@ pub(crate) struct RootTol {
 /// The state of the search between two evaluations.
 struct Search {
     good: f32,
+    /// The safe end's margin as evaluated (the stopping rule's).
+    margin: f32,
+    /// The safe end's margin as regula falsi weighs it (Illinois halves
+    /// it while the other end moves).
     g_good: f32,
     bad: f32,
     g_bad: f32,
@@ -70,11 +74,18 @@ impl Search {
             (libm::fabsf(g1 - g2) > 0.0 && ts > 0.01 && ts < 0.99).then_some(ts)
         });
         // First, and whenever the newest evaluation was unsafe and gave no
-        // usable secant (both on a flat stretch): the unit step.
+        // usable secant: the unit step; but where the two latest were
+        // unsafe at the same margin the unsafe side is flat (the least
+        // altitude set by a feature the depth does not move), and unit
+        // steps would crawl along it: bisect.
         let newest_bad = self.latest.is_none_or(|((_, g1), _)| g1 < 0.0);
+        let flat_bad = self
+            .latest
+            .is_some_and(|((_, g1), (_, g2))| g1 < 0.0 && g1.to_bits() == g2.to_bits());
         match secant {
             _ if step == 0 && g_bad < 0.0 && unit < width => 1.0 - unit / width,
             Some(ts) => ts,
+            None if flat_bad => 0.5,
             None if newest_bad && g_bad < 0.0 && unit < width => 1.0 - unit / width,
             None => t,
         }
@@ -109,6 +120,7 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
     };
     let mut s = Search {
         good: good.0,
+        margin: g_good,
         g_good,
         bad: bad.0,
         g_bad,
@@ -118,7 +130,7 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
     };
     let mut inner = None;
     for step in 0..rule.steps {
-        if s.g_good <= rule.tol || libm::fabsf(s.good - s.bad) <= rule.width {
+        if s.margin <= rule.tol || libm::fabsf(s.good - s.bad) <= rule.width {
             break;
         }
         let mid = s.good + s.next_t(step, rule.tol) * (s.bad - s.good);
@@ -133,6 +145,7 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
                     inner = Some((s.good, prev));
                 }
                 s.good = mid;
+                s.margin = g;
                 s.g_good = g;
                 at = Some(p);
                 if s.kept_bad {
@@ -188,6 +201,22 @@ mod tests {
         assert!((0.0..=0.02).contains(&g), "{} -> {g}", r.z);
         // Both ends, then the unit step.
         assert_eq!(n, 3);
+    }
+
+    /// The unsafe side flat (a least altitude set beyond the boundary by a
+    /// feature the depth does not move): unit steps would crawl 3.3 m at a
+    /// time, and regula falsi's weighting of the safe end must not pass for
+    /// its margin. (Before: stopped after 12 steps at the safe end, margin
+    /// 28.2, the halved weight taken for the margin; `unseen_23_3` track 4
+    /// of `check_planner.py --seed 23`.)
+    #[test]
+    fn bisects_a_flat_unsafe_side() {
+        let f = |z: f32| -> Result<(f32, ()), ()> {
+            Ok((if z <= 900.0 { 0.3 * (900.0 - z) } else { -3.3 }, ()))
+        };
+        let r = safe_boundary((806.0, None), (954.7, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        assert!((0.0..=0.02).contains(&g), "{} -> {g}", r.z);
     }
 
     #[test]
