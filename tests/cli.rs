@@ -1069,3 +1069,27 @@ fn a_warm_last_track_stays_by_its_boundary() {
         "track 5: J {j5} vs the best safe 2.319 15e6 at 137.15 m"
     );
 }
+
+/// The horizon's plateau escape rescans, in its second round, what its
+/// first round scanned but did not jump: on a random canyon line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 13`, `unseen_13_7`)
+/// the cold call ended with tracks 1 and 3 on plateaus; track 1 jumped,
+/// and track 3 stayed on its saturated climb (364.1 m) because it had been
+/// scanned before the jump: the line's `J` 3.7006e6 m³, 1.1015× the f64
+/// beam search's best safe plan (3.3596e6 m³, track 3 at 520.3 m). The
+/// checker's bound is 1.10×.
+#[test]
+fn a_plateau_left_after_another_jump() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
+    let (p, w) = (
+        format!("{dir}/plateau_second.csv"),
+        format!("{dir}/plateau_second.waypoints.csv"),
+    );
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.10 * 3.3596e6,
+        "J {total} vs the best safe 3.3596e6"
+    );
+}
