@@ -8,8 +8,11 @@
 //! (`check_planner.py --seed 23`, `unseen_23_1`): the SQP held track 1 at
 //! 934.2 m with track 2's least altitude at 60.08 m, `J` 1.64× the best
 //! safe plan's (961.7, 1 087.1 m). The escape: the later depth moved by
-//! the mission's band `h_r − h_a` towards the vehicle (at most half way),
-//! and the SQP restarted from there, kept only if it ends better.
+//! the mission's band `h_r − h_a` towards the vehicle (at most half way);
+//! where that lifts the track's least altitude [`LIFT`] of the band above
+//! its target (one flight of the track: a dive still saturated past the
+//! sample lifts nothing), the SQP restarted from there, kept only if it
+//! ends better.
 
 use crate::optim::Bounds;
 
