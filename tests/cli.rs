@@ -272,6 +272,15 @@ fn non_utf8_argument() {
     );
 }
 
+/// The profile and waypoint files of `tests/fixtures/horizon/NAME*.csv`.
+fn horizon_fixture(name: &str) -> (String, String) {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
+    (
+        format!("{dir}/{name}.csv"),
+        format!("{dir}/{name}.waypoints.csv"),
+    )
+}
+
 fn json_of(args: &[&str]) -> serde_json::Value {
     let out = run(args);
     assert_eq!(
@@ -1007,11 +1016,7 @@ fn progress_on_stderr_for_long_runs() {
 /// track 3 from the state the climb reaches is 140.21 m (1.796e6 m³).
 #[test]
 fn a_crash_does_not_end_the_planning() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w) = (
-        format!("{dir}/crash_recover.csv"),
-        format!("{dir}/crash_recover.waypoints.csv"),
-    );
+    let (p, w) = horizon_fixture("crash_recover");
     let v = json_of(&[
         "--profile",
         &p,
@@ -1049,11 +1054,7 @@ fn a_crash_does_not_end_the_planning() {
 /// best safe `J_5` 2.319 15e6 m³ at 137.15 m (least altitude 60.004 m).
 #[test]
 fn a_warm_last_track_stays_by_its_boundary() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w) = (
-        format!("{dir}/warm_last.csv"),
-        format!("{dir}/warm_last.waypoints.csv"),
-    );
+    let (p, w) = horizon_fixture("warm_last");
     let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
     let tracks = v["tracks"].as_array().unwrap();
     let head = [110.21864, 147.11755, 141.34277, 169.78854];
@@ -1080,11 +1081,7 @@ fn a_warm_last_track_stays_by_its_boundary() {
 /// checker's bound is 1.10×.
 #[test]
 fn a_plateau_left_after_another_jump() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w) = (
-        format!("{dir}/plateau_second.csv"),
-        format!("{dir}/plateau_second.waypoints.csv"),
-    );
+    let (p, w) = horizon_fixture("plateau_second");
     let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
     let total = v["total_J"].as_f64().unwrap();
     assert_eq!(v["safe"], true);

@@ -198,6 +198,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
             jumped |= bit;
         }
+        // (The kink is the first run's: a kept plateau restart may have
+        // moved the point since; `kink.rs` flies the lift test from where
+        // the workspace now stands, and keeps a restart only if better.)
         if let Some(g) = end.kink
             && iterations < self.cfg.bfgs.max_iterations
         {
