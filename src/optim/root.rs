@@ -10,6 +10,15 @@
 //! then the secant through the two latest evaluations, and the Illinois
 //! variant of regula falsi on the bracket when the secant falls outside it
 //! (Dowell & Jarratt 1971). Each aims at half the tolerance above 0.
+//!
+//! A margin within the tolerance ends the search only where it shows the
+//! boundary is near: a safe end the search reached by that unit step, or
+//! whose margin differs from the safe end's before. A safe side can be
+//! flat too (the least altitude set where the depth does not act yet, at
+//! whatever margin the previous track's boundary left it): a caller's safe
+//! end there, or a safe evaluation at the same margin, may lie anywhere on
+//! that side, so the search goes on, by the unit step where it lands
+//! inside the bracket, else by bisection.
 
 /// One end of a bracket: a point and its margin when known.
 pub(crate) type End = (f32, Option<f32>);
@@ -50,12 +59,16 @@ struct Search {
     /// Which end the last step kept (Illinois halves its value).
     kept_good: bool,
     kept_bad: bool,
+    /// Whether the safe end may lie on a flat safe side (module docs):
+    /// the caller's, or reached at its predecessor's very margin other
+    /// than by the unit step.
+    flat: bool,
 }
 
 impl Search {
     /// Where to evaluate next, as a fraction of the way from `good` to
-    /// `bad`.
-    fn next_t(&self, step: u32, tol: f32) -> f32 {
+    /// `bad`, and whether that is the unit step from the unsafe end.
+    fn next_t(&self, step: u32, tol: f32) -> (f32, bool) {
         let (good, bad, g_good, g_bad) = (self.good, self.bad, self.g_good, self.g_bad);
         // Regula falsi, kept inside the middle 98 % of the bracket.
         let t = if g_good > 0.0 && g_bad < 0.0 && (g_good - g_bad).is_finite() {
@@ -67,6 +80,15 @@ impl Search {
         // The unit step from the unsafe end: its deficit plus half the
         // tolerance (the hinge's sloped side falls at unit slope).
         let unit = -g_bad + 0.5 * tol;
+        let t_unit = (g_bad < 0.0 && unit < width).then(|| 1.0 - unit / width);
+        if self.flat && self.margin <= tol {
+            // Probing a flat safe side: the unit step lands on the
+            // boundary if the unsafe end is on the sloped side.
+            return match t_unit {
+                Some(tu) if tu > 0.01 && tu < 0.999 => (tu, true),
+                _ => (0.5, false),
+            };
+        }
         let aim = |z: f32| (z - good) / (bad - good);
         // The secant, when it has two distinct margins and lands inside.
         let secant = self.latest.and_then(|((z1, g1), (z2, g2))| {
@@ -82,12 +104,12 @@ impl Search {
         let flat_bad = self
             .latest
             .is_some_and(|((_, g1), (_, g2))| g1 < 0.0 && g1.to_bits() == g2.to_bits());
-        match secant {
-            _ if step == 0 && g_bad < 0.0 && unit < width => 1.0 - unit / width,
-            Some(ts) => ts,
-            None if flat_bad => 0.5,
-            None if newest_bad && g_bad < 0.0 && unit < width => 1.0 - unit / width,
-            None => t,
+        match (secant, t_unit) {
+            (_, Some(tu)) if step == 0 => (tu, true),
+            (Some(ts), _) => (ts, false),
+            (None, _) if flat_bad => (0.5, false),
+            (None, Some(tu)) if newest_bad => (tu, true),
+            _ => (t, false),
         }
     }
 }
@@ -127,13 +149,16 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
         latest: None,
         kept_good: false,
         kept_bad: false,
+        flat: true,
     };
     let mut inner = None;
     for step in 0..rule.steps {
-        if s.margin <= rule.tol || libm::fabsf(s.good - s.bad) <= rule.width {
+        let near = s.margin <= rule.tol && !s.flat;
+        if near || libm::fabsf(s.good - s.bad) <= rule.width {
             break;
         }
-        let mid = s.good + s.next_t(step, rule.tol) * (s.bad - s.good);
+        let (t, unit) = s.next_t(step, rule.tol);
+        let mid = s.good + t * (s.bad - s.good);
         let flown = eval(mid);
         let g_mid = flown.as_ref().map_or(f32::NEG_INFINITY, |(g, _)| *g);
         s.latest = g_mid
@@ -145,6 +170,7 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
                     inner = Some((s.good, prev));
                 }
                 s.good = mid;
+                s.flat = !unit && g.to_bits() == s.margin.to_bits();
                 s.margin = g;
                 s.g_good = g;
                 at = Some(p);
@@ -217,6 +243,33 @@ mod tests {
         let r = safe_boundary((806.0, None), (954.7, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!((0.0..=0.02).contains(&g), "{} -> {g}", r.z);
+    }
+
+    /// The safe side flat at a margin within the tolerance (the track's
+    /// least altitude set at its start, where the previous track's boundary
+    /// left it 0.0186 m above), falling 1 m per m beyond 909.14 m: the
+    /// caller's safe end at 866.87 m is no boundary. (Before: answered it
+    /// unmoved; `check_planner.py --seed 53` with a slower vehicle,
+    /// `unseen_53_7` track 3, `J` 1.74× the best safe.)
+    #[test]
+    fn probes_a_flat_safe_side() {
+        let f = |z: f32| -> Result<(f32, ()), ()> { Ok((0.0186_f32.min(909.16 - z), ())) };
+        let r = safe_boundary((866.87, Some(0.0186)), (1086.6, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        assert!(r.z > 909.1 && (0.0..=0.02).contains(&g), "{} -> {g}", r.z);
+    }
+
+    /// The same on a path parameter, where a unit step of the margin does
+    /// not fit in the bracket: bisection finds the corner (the continuation
+    /// search from its anchor, `search.rs`; before: stopped at the anchor).
+    #[test]
+    fn bisects_towards_a_flat_safe_sides_corner() {
+        let f = |t: f32| -> Result<(f32, ()), ()> {
+            Ok((0.0091_f32.min(0.0091 - 475.0 * (t - 0.89)), ()))
+        };
+        let r = safe_boundary((0.0, Some(0.0091)), (1.0, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        assert!(r.z > 0.888 && g >= 0.0, "{} -> {g}", r.z);
     }
 
     #[test]
