@@ -814,8 +814,9 @@ def unseen_case(seed, i):
             "h_r": 80.0, "h_a": 60.0}
 
 
-def write_case(case, base):
-    """Write (or point at) PROFILE.csv, WAYPOINTS.csv and VEHICLE.toml."""
+def write_case(case, base, vehicle=None):
+    """Write (or point at) PROFILE.csv, WAYPOINTS.csv and VEHICLE.toml
+    (the case's h_r, h_a, and every key of the `vehicle` dict, if any)."""
     d = os.path.join(base, case["name"])
     os.makedirs(d, exist_ok=True)
     if "xs" in case:
@@ -827,7 +828,9 @@ def write_case(case, base):
         P = os.path.join(DATA, case["name"] + ".csv")
         W = os.path.join(DATA, case["name"] + ".waypoints.csv")
     V = os.path.join(d, "VEHICLE.toml")
-    check_plan.write_toml(V, {"reference_altitude": case["h_r"], "min_altitude": case["h_a"]})
+    cfg = {"reference_altitude": case["h_r"], "min_altitude": case["h_a"]}
+    cfg.update(vehicle or {})
+    check_plan.write_toml(V, cfg)
     case.update(P=P, W=W, V=V, dir=d)
     return case
 
@@ -1371,6 +1374,9 @@ def main(argv=None):
     ap.add_argument("--timeout", type=float, default=600.0, help="seconds per tool run")
     ap.add_argument("--json-out", metavar="FILE", help="write every number to FILE")
     ap.add_argument("--keep", metavar="DIR", help="keep the generated inputs in DIR")
+    ap.add_argument("--vehicle", metavar="TOML",
+                    help="a vehicle for every case: its keys (speed, [plant], "
+                         "[depth_pid], ...) are written into each VEHICLE.toml")
     a = ap.parse_args(argv)
 
     cases = [] if a.no_shared else [{"name": n, "h_r": hr, "h_a": ha} for n, hr, ha in SHARED]
@@ -1379,8 +1385,13 @@ def main(argv=None):
         cases = [c for c in cases if any(s in c["name"] for s in a.only)]
     base = a.keep or tempfile.mkdtemp(prefix="check_planner_")
     os.makedirs(base, exist_ok=True)
+    vehicle = None
+    if a.vehicle:
+        import tomllib
+        with open(a.vehicle, "rb") as f:
+            vehicle = tomllib.load(f)
     for c in cases:
-        write_case(c, base)
+        write_case(c, base, vehicle)
     o = {"beam": a.beam, "nz": a.nz, "seed": a.seed, "self_test": a.self_test,
          "bin_cmd": a.bin_cmd, "cwd": a.cwd, "timeout": a.timeout}
     t0 = time.time()
