@@ -142,6 +142,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
         let iterations =
             self.escape_plateaus(&mut obj, (s.h, &s.bounds), first_step, iterations)?;
+        if s.h == 1 && self.cfg.method == Method::Bfgs && (single || !self.cfg.constrained) {
+            let guard = obj.guard;
+            self.polish_single(&mut obj, &s.bounds, guard);
+        }
         self.committed_to_boundary(&mut obj, (s.h, &s.bounds));
         let last = obj.last_flight;
         let (answer, warm) = ((iterations, None), (obj.mu, 0));

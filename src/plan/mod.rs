@@ -145,6 +145,7 @@ mod kink;
 mod objective;
 mod planner;
 mod plateau;
+mod polish;
 mod resumable;
 mod scan;
 mod search;

@@ -68,7 +68,7 @@ pub(super) fn later_margin(cfg: &PlannerConfig, m: &Mission) -> f32 {
 /// ones)` of the horizon `z` by a plain flight (m³, m, m; `+∞` with no
 /// later track), counted in `obj`'s evaluations, within its
 /// budget.
-fn horizon_flight<const N: usize, const K: usize>(
+pub(super) fn horizon_flight<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     z: &[f32; K],
 ) -> Result<(f32, f32, f32), Stop> {

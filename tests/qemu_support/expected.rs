@@ -146,7 +146,7 @@ pub const TRACKWISE_K1: [TrackPlan; 5] = [
         min_altitude: f32::from_bits(0x427fbc62) /* 63.933968 */,
         objective: f32::from_bits(0x483b0b72) /* 191533.78 */,
         iterations: 1,
-        evaluations: 10,
+        evaluations: 12,
         history_len: 2,
         history_hash: 0x29e9081a,
         next_x: f32::from_bits(0x455c525b) /* 3525.1472 */,
