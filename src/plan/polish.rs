@@ -61,18 +61,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return;
         };
         let j0 = w.j;
-        let bar = SHARE * libm::fabsf(j0);
+        let share = SHARE * libm::fabsf(j0);
         // The last iteration's decrease of `J`.
         let fell = match w.history.as_slice() {
             [.., a, b] => a - b,
             _ => 0.0,
         };
-        if !(libm::fabsf(g0) * STEP > bar || fell > bar) {
+        if !(libm::fabsf(g0) * STEP > share || fell > share) {
             return;
         }
         let bar = j0 - self.cfg.bfgs.tol.j_threshold(j0);
         let base = w.z;
-        let mut at = |z: f32| flown_at(obj, (&base, z), h_safe);
+        let inside = |z: f32| crate::num::max(crate::num::min(z, hi), lo);
+        let mut at = |z: f32| {
+            let z = inside(z);
+            (z.to_bits() != z0.to_bits())
+                .then(|| flown_at(obj, (&base, z), h_safe))
+                .flatten()
+        };
         let sides = [at(z0 - STEP), at(z0 + STEP)];
         let Some(first) = sides
             .into_iter()
@@ -87,7 +93,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut step = STEP;
         for _ in 0..DOUBLINGS {
             step *= 2.0;
-            let z = crate::num::max(crate::num::min(best.0 + dir * step, hi), lo);
+            let z = inside(best.0 + dir * step);
             if z.to_bits() == best.0.to_bits() {
                 break;
             }
