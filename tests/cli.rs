@@ -1090,3 +1090,21 @@ fn a_plateau_left_after_another_jump() {
         "J {total} vs the best safe 3.3596e6"
     );
 }
+
+/// A horizon with no safe plan whose SQP stalls infeasible: on a random
+/// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
+/// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200
+/// iterations, the merit moving a few parts in 10⁸, 2 410 and 2 390
+/// flights. The run now stops once its merit has stayed put five
+/// iterations in a row (after its restorations): 88 and 86 flights, the
+/// same depths.
+#[test]
+fn a_stalled_infeasible_horizon_stops() {
+    let (p, w) = horizon_fixture("stuck_infeasible");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    assert_eq!(v["safe"], false);
+    for t in v["tracks"].as_array().unwrap() {
+        let n = t["evaluations"].as_u64().unwrap();
+        assert!(n <= 300, "track {}: {n} flights", t["track"]);
+    }
+}

@@ -34,7 +34,8 @@
 //! 3.14b); a full step that changes `φ` by less than that; else the
 //! iteration cap, or no acceptable step (`LineSearchFailed`). A run that
 //! finds no acceptable step while infeasible first tries a feasibility
-//! restoration (`Run::restore`, at most [`RESTORATIONS`] a run): on a
+//! restoration (`Run::restore`, at most [`RESTORATIONS`] a run), as does
+//! one whose merit stayed unmoved [`STALLS`] iterations in a row: on a
 //! random line (`unseen_11_1` of `check_planner.py --seed 11`) the runs
 //! stopped infeasible and the line's `J` was 1.32× the best safe; with the
 //! restoration, 1.002×.
@@ -66,6 +67,13 @@ const RESTORATIONS: u32 = 3;
 /// less (a problem with no feasible point near, Monterey 3's, would
 /// otherwise buy shavings of `v` with gradient evaluations).
 const RESTORED: f32 = 0.5;
+
+/// Infeasible iterations in a row that leave the merit `φ` unmoved (within
+/// the relative tolerance) before the run counts as stalled: on an
+/// infeasible random line (`check_planner.py --seed 43`, `unseen_43_6`)
+/// Armijo's 2⁻¹⁰ steps moved `φ` by a few parts in 10⁸ for 200 iterations,
+/// 2 400 flights a call.
+const STALLS: u32 = 5;
 
 /// Minimizes `obj` over its first `n` variables from `z0` within `bounds`
 /// (the others held), feasible within `feas_tol` (m of `v`), by the SQP of
@@ -101,6 +109,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         evaluations: 1,
         iterations: 0,
         skipped: 0,
+        stalls: 0,
     };
     obj.linearize(&run.z, metric.is_none(), &mut run.lin)
         .map_err(OptimError::Start)?;
@@ -123,6 +132,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
             && run.restore(obj, (bounds, n))
         {
             restorations = restorations.saturating_add(1);
+            run.stalls = 0;
             stop = None;
         }
         // One value per completed iteration, the last included.
@@ -182,6 +192,8 @@ struct Run<const K: usize> {
     evaluations: u32,
     iterations: u32,
     skipped: u32,
+    /// Infeasible iterations in a row that left the merit unmoved.
+    stalls: u32,
 }
 
 impl<const K: usize> Run<K> {
@@ -262,7 +274,17 @@ impl<const K: usize> Run<K> {
         // a kink of the constraints' minima would only crawl on.
         let small = libm::fabsf(phi - phi_new) <= cfg.tol.j_threshold(phi_new);
         let _ = alpha;
-        (small && lin.infeasibility <= feas_tol).then_some(Status::Converged)
+        if small && lin.infeasibility <= feas_tol {
+            return Some(Status::Converged);
+        }
+        // Infeasible, the merit unmoved [`STALLS`] iterations in a row:
+        // no acceptable step, as far as the run can tell.
+        self.stalls = if small {
+            self.stalls.saturating_add(1)
+        } else {
+            0
+        };
+        (self.stalls >= STALLS).then_some(Status::LineSearchFailed)
     }
 }
 
