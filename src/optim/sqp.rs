@@ -269,16 +269,21 @@ impl<const K: usize> Run<K> {
             self.rho,
             alpha
         );
-        // A feasible step that changed the merit by less than the relative
-        // tolerance (as BFGS's 3.14b), full or damped: a damped one near
-        // a kink of the constraints' minima would only crawl on.
         let small = libm::fabsf(phi - phi_new) <= cfg.tol.j_threshold(phi_new);
         let _ = alpha;
-        if small && lin.infeasibility <= feas_tol {
+        self.stop_after(small, feas_tol)
+    }
+
+    /// Whether the run ends after a step that changed the merit by less
+    /// than the relative tolerance (`small`) or not. Feasible within
+    /// `feas_tol` (m): converged (as BFGS's 3.14b), full step or damped (a
+    /// damped one near a kink of the constraints' minima would only crawl
+    /// on). Infeasible, the merit unmoved [`STALLS`] iterations in a row:
+    /// no acceptable step, as far as the run can tell.
+    fn stop_after(&mut self, small: bool, feas_tol: f32) -> Option<Status> {
+        if small && self.lin.infeasibility <= feas_tol {
             return Some(Status::Converged);
         }
-        // Infeasible, the merit unmoved [`STALLS`] iterations in a row:
-        // no acceptable step, as far as the run can tell.
         self.stalls = if small {
             self.stalls.saturating_add(1)
         } else {
