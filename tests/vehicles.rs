@@ -2,8 +2,9 @@
 //! `tools/reference/check_planner.py --vehicle` finds them: a depth loop
 //! that integrates (`depth_pid.ki = 0.02`, with conditional integration,
 //! contract §7) makes a track's `J` jump by small steps as its depth
-//! moves (`src/plan/polish.rs`). Bounds from the checker's f64 brute force
-//! over the track's depth.
+//! moves (`src/plan/polish.rs`); a vehicle of little pitch authority
+//! leaves the horizon's later depths without gradient
+//! (`src/plan/wider.rs`). Bounds from the checker's f64 searches.
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)]
 #![allow(clippy::arithmetic_side_effects, clippy::float_cmp)]
 
@@ -67,4 +68,32 @@ fn a_staircase_is_read_at_its_trend() {
     );
     let j = tracks[1]["J"].as_f64().unwrap();
     assert!(j <= 1.005 * 1.562_91e5, "track 2: J {j} vs the best");
+}
+
+/// Little pitch authority (`check_planner.py --seed 71 --vehicle`,
+/// `unseen_71_4`: 3 m/s, 15° pitch limit, a plant of positive gain): every
+/// track's dive or climb stays saturated, so every depth after the first
+/// has exactly zero gradient, and the cold SQP, from a start infeasible by
+/// 279 m summed, restored feasibility by moving the first depth alone
+/// (394 → 133 m). The line's `J` was 8.5158e7 m³, 2.04× the f64 beam
+/// search's best safe 4.16939e7 m³ (`src/plan/wider.rs`).
+#[test]
+fn a_low_authority_vehicle_starts_again_wider() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
+    let (p, w, c) = (
+        format!("{dir}/low_authority.csv"),
+        format!("{dir}/low_authority.waypoints.csv"),
+        format!("{dir}/low_authority.toml"),
+    );
+    let out = run(&["--profile", &p, "--waypoints", &w, "--config", &c, "--json"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(total <= 1.10 * 4.169_39e7, "J {total} vs the best safe");
 }

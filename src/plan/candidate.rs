@@ -15,7 +15,7 @@ use super::fallback::{Flown, fallback, from_warm};
 use super::flights::Flights;
 use super::objective::PlanObjective;
 use super::planner::Warm;
-use super::scan::{ScanLog, ScanSpec, scan_start, search_box};
+use super::scan::{BEAM, ScanLog, ScanSpec, scan_start, search_box};
 use super::single::{self, Decision};
 use super::solve::{Merge, later_margin};
 use super::status::{Found, OptimizerStop};
@@ -247,6 +247,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.work.history.clear();
         let (mut iterations, plateaus) =
             self.solve_sqp(&mut obj, z0, (s.h, &s.bounds), tol, skip)?;
+        if s.warm.is_none() {
+            let (h, mu) = (s.h, s.mu);
+            let at = (tol, s.h_safe, iterations);
+            iterations = self.wider_start((&mut obj, fl, scan), (h, &s.bounds, mu), at);
+        }
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {
             iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), (tol, s.h_safe))?;
@@ -454,6 +459,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 points,
                 mu: s.mu,
                 beam: self.cfg.method == Method::Bfgs,
+                width: BEAM,
             };
             scan_start(fl, &spec, &mut z0, &mut curvature, scan)?;
         }

@@ -152,6 +152,7 @@ mod search;
 mod single;
 mod solve;
 mod status;
+mod wider;
 mod within;
 
 pub use answer::Plan;

@@ -223,6 +223,9 @@ pub(super) struct ScanSpec<'b, const K: usize> {
     /// Whether a horizon is scanned as a beam search (else greedily,
     /// track by track: the paper's GD keeps its start).
     pub beam: bool,
+    /// The beam's width (paths kept at each track, at most
+    /// [`BEAM_WIDE`]).
+    pub width: usize,
 }
 
 /// Coarse scan of tracks `from..h` of the horizon, each from the state
@@ -295,7 +298,11 @@ pub(super) fn scan_start<const N: usize, const K: usize>(
 }
 
 /// Paths kept by the horizon's beam scan at each track.
-const BEAM: usize = 2;
+pub(super) const BEAM: usize = 2;
+
+/// Paths kept by the wider beam of a second start (`solve.rs`), and the
+/// most any beam keeps.
+pub(super) const BEAM_WIDE: usize = 4;
 
 /// One path of the beam scan: its depths so far, the objective they add
 /// up to and the state they leave.
@@ -308,10 +315,15 @@ struct Path<const N: usize, const K: usize> {
     st: VehicleState<N>,
 }
 
-/// Keeps `p` among the `BEAM` lowest-objective paths of `beam`, sorted,
+/// Keeps `p` among the `width` lowest-objective paths of `beam`, sorted,
 /// at most one per grid point of the track scanned (so that the beam keeps
 /// distinct depths of it, not one depth from several parents).
-fn keep<const N: usize, const K: usize>(beam: &mut [Option<Path<N, K>>; BEAM], p: Path<N, K>) {
+fn keep<const N: usize, const K: usize>(
+    beam: &mut [Option<Path<N, K>>; BEAM_WIDE],
+    p: Path<N, K>,
+    width: usize,
+) {
+    let beam = beam.get_mut(..width).unwrap_or(&mut []);
     if let Some(i) = beam.iter().position(|s| s.is_some_and(|s| s.k == p.k)) {
         if beam
             .get(i)
@@ -322,7 +334,7 @@ fn keep<const N: usize, const K: usize>(beam: &mut [Option<Path<N, K>>; BEAM], p
             return;
         }
         // Drop the worse path of the same grid point, closing the gap.
-        for m in i..BEAM {
+        for m in i..width {
             let after = beam.get(m.saturating_add(1)).copied().flatten();
             if let Some(slot) = beam.get_mut(m) {
                 *slot = after;
@@ -359,7 +371,8 @@ fn beam_scan<const N: usize, const K: usize>(
     log: &mut ScanLog,
 ) -> Result<(), PlanError> {
     let n = spec.points;
-    let mut beam: [Option<Path<N, K>>; BEAM] = [None; BEAM];
+    let width = spec.width.clamp(1, BEAM_WIDE);
+    let mut beam: [Option<Path<N, K>>; BEAM_WIDE] = [None; BEAM_WIDE];
     keep(
         &mut beam,
         Path {
@@ -368,13 +381,14 @@ fn beam_scan<const N: usize, const K: usize>(
             phi: 0.0,
             st,
         },
+        width,
     );
     for j in spec.from..spec.h {
         let (lo, hi) = (
             spec.bounds.lo.get(j).copied().unwrap_or(0.0),
             spec.bounds.hi.get(j).copied().unwrap_or(0.0),
         );
-        let mut next: [Option<Path<N, K>>; BEAM] = [None; BEAM];
+        let mut next: [Option<Path<N, K>>; BEAM_WIDE] = [None; BEAM_WIDE];
         for parent in beam.iter().flatten() {
             // Each parent's own reach: beyond it the track flies the same.
             let t = fl.track.saturating_add(j);
@@ -395,7 +409,7 @@ fn beam_scan<const N: usize, const K: usize>(
                 path.st = end;
                 path.k = k;
                 if path.phi.is_finite() {
-                    keep(&mut next, path);
+                    keep(&mut next, path, width);
                 }
             }
         }
