@@ -51,6 +51,33 @@ fn a_flat_track_start_is_no_boundary() {
     assert!(j3 <= 1.005 * 2.141_06e5, "track 3: J {j3} vs the best safe");
 }
 
+/// The same flat side above the tolerance, its corner 1.7 m from the
+/// unsafe end of a 206 m bracket (`check_planner.py --seed 81` with h_r/h_a
+/// 30/20, `unseen_81_4`): track 2's constrained solve answered 810.38 m,
+/// `J` 2.2816e7 m³, 4.7× the f64 brute force's best safe 4.80787e6 m³
+/// (1 014.85 m).
+#[test]
+fn a_corner_near_the_unsafe_end_is_reached() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
+    let (p, w, c) = (
+        format!("{dir}/far_corner.csv"),
+        format!("{dir}/far_corner.waypoints.csv"),
+        format!("{dir}/far_corner.toml"),
+    );
+    let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
+    let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
+    let tracks = v["tracks"].as_array().unwrap();
+    let d1 = tracks[0]["depth"].as_f64().unwrap();
+    assert!(
+        (d1 - 1016.556).abs() < 0.01,
+        "track 1 at {d1}: not the premise"
+    );
+    let t2 = &tracks[1];
+    let j2 = t2["J"].as_f64().unwrap();
+    assert_eq!(t2["safe"], true, "{t2}");
+    assert!(j2 <= 1.005 * 4.807_87e6, "track 2: J {j2} vs the best safe");
+}
+
 /// The safe mode with a one-track horizon (its continuation certified to
 /// the line's end) on the shared profiles, against the best safe `J` of
 /// the f64 exhaustive search (`scripts/j_gap.py`, BENCHMARKS.md "J

@@ -20,6 +20,14 @@
 //! that side, so the search goes on, by the unit step where it lands
 //! inside the bracket, else by bisection.
 
+/// How far towards the unsafe end (of the bracket) a secant may land. A
+/// wide bracket whose boundary lies near its unsafe end (a long flat safe
+/// side) puts the secant's aim past 99 % of it; refused there, unit steps
+/// that assume a slope of 1 crawled towards a boundary of slope 0.17 and
+/// the search ran out of steps at its unmoved safe end (`check_planner.py
+/// --seed 81`, h_r/h_a 30/20, `unseen_81_4` track 2: 4.7× the best safe).
+const SECANT_REACH: f32 = 0.9999;
+
 /// One end of a bracket: a point and its margin when known.
 pub(crate) type End = (f32, Option<f32>);
 
@@ -93,7 +101,7 @@ impl Search {
         // The secant, when it has two distinct margins and lands inside.
         let secant = self.latest.and_then(|((z1, g1), (z2, g2))| {
             let ts = aim(z1 + (0.5 * tol - g1) * (z1 - z2) / (g1 - g2));
-            (libm::fabsf(g1 - g2) > 0.0 && ts > 0.01 && ts < 0.99).then_some(ts)
+            (libm::fabsf(g1 - g2) > 0.0 && ts > 0.01 && ts < SECANT_REACH).then_some(ts)
         });
         // First, and whenever the newest evaluation was unsafe and gave no
         // usable secant: the unit step; but where the two latest were
@@ -270,6 +278,22 @@ mod tests {
         let r = safe_boundary((0.0, Some(0.0091)), (1.0, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!(r.z > 0.888 && g >= 0.0, "{} -> {g}", r.z);
+    }
+
+    /// A flat safe side above the tolerance (0.089 m) ending 1.7 m from
+    /// the unsafe end of a 206 m bracket, the unsafe side falling 0.17 m
+    /// per m: the secant's aim lies past 99 % of the bracket. (Before:
+    /// unit steps crawled 0.2 m at a time and the search answered its
+    /// unmoved safe end; `check_planner.py --seed 81`, h_r/h_a 30/20,
+    /// `unseen_81_4` track 2, `J` 4.7× the best safe.)
+    #[test]
+    fn a_secant_may_land_near_the_unsafe_end() {
+        let f = |z: f32| -> Result<(f32, ()), ()> {
+            Ok((0.089_f32.min(0.089 - 0.17 * (z - 1014.9)), ()))
+        };
+        let r = safe_boundary((810.38, Some(0.089)), (1016.59, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        assert!(r.z > 1014.0 && g >= 0.0, "{} -> {g}", r.z);
     }
 
     #[test]

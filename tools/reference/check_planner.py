@@ -828,8 +828,12 @@ def write_case(case, base, vehicle=None):
         P = os.path.join(DATA, case["name"] + ".csv")
         W = os.path.join(DATA, case["name"] + ".waypoints.csv")
     V = os.path.join(d, "VEHICLE.toml")
+    # (A vehicle's own h_r / h_a replace the case's, for the checks too.)
+    vehicle = vehicle or {}
+    case["h_r"] = float(vehicle.get("reference_altitude", case["h_r"]))
+    case["h_a"] = float(vehicle.get("min_altitude", case["h_a"]))
     cfg = {"reference_altitude": case["h_r"], "min_altitude": case["h_a"]}
-    cfg.update(vehicle or {})
+    cfg.update(vehicle)
     check_plan.write_toml(V, cfg)
     case.update(P=P, W=W, V=V, dir=d)
     return case
@@ -1376,7 +1380,8 @@ def main(argv=None):
     ap.add_argument("--keep", metavar="DIR", help="keep the generated inputs in DIR")
     ap.add_argument("--vehicle", metavar="TOML",
                     help="a vehicle for every case: its keys (speed, [plant], "
-                         "[depth_pid], ...) are written into each VEHICLE.toml")
+                         "[depth_pid], ..., and reference_altitude / min_altitude, "
+                         "which replace the case's) are written into each VEHICLE.toml")
     a = ap.parse_args(argv)
 
     cases = [] if a.no_shared else [{"name": n, "h_r": hr, "h_a": ha} for n, hr, ha in SHARED]
