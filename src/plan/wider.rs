@@ -27,8 +27,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// The second start of the module docs for a cold call's horizon of
     /// `h` tracks in `bounds` (penalty weight `mu` for the scan), feasible
     /// within `tol` (m), `scan` the first track's scanned depths and
-    /// `h_safe` the certified altitude (m), after `iterations` so far. Returns the iterations
-    /// so far. Not inlined: the scan's state stays off the SQP's stack.
+    /// `h_safe` the certified altitude (m), after `iterations` so far.
+    /// Returns the iterations so far. Not inlined: the scan's state stays
+    /// off the SQP's stack.
     #[inline(never)]
     pub(super) fn wider_start(
         &mut self,
