@@ -10,18 +10,7 @@
 
 mod tool;
 
-use tool::run;
-
-fn json_of(args: &[&str]) -> serde_json::Value {
-    let out = run(args);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
+use tool::{fixture, json_of};
 
 /// Track-wise with a slower vehicle (`check_planner.py --seed 53
 /// --vehicle`, `unseen_53_7`: 1 m/s, `Ts` 0.2 s, 30° limits, another
@@ -31,12 +20,7 @@ fn json_of(args: &[&str]) -> serde_json::Value {
 /// (909.161 m).
 #[test]
 fn a_flat_track_start_is_no_boundary() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w, c) = (
-        format!("{dir}/flat_start.csv"),
-        format!("{dir}/flat_start.waypoints.csv"),
-        format!("{dir}/flat_start.toml"),
-    );
+    let (p, w, c) = fixture("flat_start");
     let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
     let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
     let tracks = v["tracks"].as_array().unwrap();
@@ -58,12 +42,7 @@ fn a_flat_track_start_is_no_boundary() {
 /// (1 014.85 m).
 #[test]
 fn a_corner_near_the_unsafe_end_is_reached() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w, c) = (
-        format!("{dir}/far_corner.csv"),
-        format!("{dir}/far_corner.waypoints.csv"),
-        format!("{dir}/far_corner.toml"),
-    );
+    let (p, w, c) = fixture("far_corner");
     let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
     let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
     let tracks = v["tracks"].as_array().unwrap();

@@ -17,7 +17,7 @@
 
 mod tool;
 
-use tool::{run, tool};
+use tool::{fixture, json_of, run, tool};
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -272,26 +272,6 @@ fn non_utf8_argument() {
     );
 }
 
-/// The profile and waypoint files of `tests/fixtures/horizon/NAME*.csv`.
-fn horizon_fixture(name: &str) -> (String, String) {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    (
-        format!("{dir}/{name}.csv"),
-        format!("{dir}/{name}.waypoints.csv"),
-    )
-}
-
-fn json_of(args: &[&str]) -> serde_json::Value {
-    let out = run(args);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_slice(&out.stdout).unwrap()
-}
-
 #[test]
 fn evaluate_json_has_every_field() {
     let v = json_of(&["--depths", "990,900,700,400,250", "--json"]);
@@ -501,14 +481,7 @@ fn uncertainty_keys_are_parsed_and_validated() {
     // nominal flight.
     let mut a = with_config(PROFILE, all, &["--depths", "20,20"]);
     a.push("--json".into());
-    let out = run(&refs(&a));
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let v = json_of(&refs(&a));
     for t in v["tracks"].as_array().unwrap() {
         let (c, m) = (
             t["certified_min_altitude"].as_f64().unwrap(),
@@ -1016,7 +989,7 @@ fn progress_on_stderr_for_long_runs() {
 /// track 3 from the state the climb reaches is 140.21 m (1.796e6 m³).
 #[test]
 fn a_crash_does_not_end_the_planning() {
-    let (p, w) = horizon_fixture("crash_recover");
+    let (p, w, _) = fixture("crash_recover");
     let v = json_of(&[
         "--profile",
         &p,
@@ -1054,7 +1027,7 @@ fn a_crash_does_not_end_the_planning() {
 /// best safe `J_5` 2.319 15e6 m³ at 137.15 m (least altitude 60.004 m).
 #[test]
 fn a_warm_last_track_stays_by_its_boundary() {
-    let (p, w) = horizon_fixture("warm_last");
+    let (p, w, _) = fixture("warm_last");
     let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
     let tracks = v["tracks"].as_array().unwrap();
     let head = [110.21864, 147.11755, 141.34277, 169.78854];
@@ -1081,7 +1054,7 @@ fn a_warm_last_track_stays_by_its_boundary() {
 /// checker's bound is 1.10×.
 #[test]
 fn a_plateau_left_after_another_jump() {
-    let (p, w) = horizon_fixture("plateau_second");
+    let (p, w, _) = fixture("plateau_second");
     let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
     let total = v["total_J"].as_f64().unwrap();
     assert_eq!(v["safe"], true);
@@ -1100,7 +1073,7 @@ fn a_plateau_left_after_another_jump() {
 /// same depths.
 #[test]
 fn a_stalled_infeasible_horizon_stops() {
-    let (p, w) = horizon_fixture("stuck_infeasible");
+    let (p, w, _) = fixture("stuck_infeasible");
     let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
     assert_eq!(v["safe"], false);
     for t in v["tracks"].as_array().unwrap() {

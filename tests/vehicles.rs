@@ -10,35 +10,13 @@
 
 mod tool;
 
-use tool::run;
+use tool::{fixture, json_of};
 
 /// The tracks of `plan --mode track --unconstrained` on fixture `name`.
 fn unconstrained_tracks(name: &str) -> Vec<serde_json::Value> {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w, c) = (
-        format!("{dir}/{name}.csv"),
-        format!("{dir}/{name}.waypoints.csv"),
-        format!("{dir}/{name}.toml"),
-    );
-    let out = run(&[
-        "--profile",
-        &p,
-        "--waypoints",
-        &w,
-        "--config",
-        &c,
-        "--mode",
-        "track",
-        "--unconstrained",
-        "--json",
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (p, w, c) = fixture(name);
+    let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
+    let v = json_of(&[&args[..], &["--mode", "track", "--unconstrained", "--json"]].concat());
     v["tracks"].as_array().unwrap().clone()
 }
 
@@ -79,20 +57,8 @@ fn a_staircase_is_read_at_its_trend() {
 /// search's best safe 4.16939e7 m³ (`src/plan/wider.rs`).
 #[test]
 fn a_low_authority_vehicle_starts_again_wider() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/horizon");
-    let (p, w, c) = (
-        format!("{dir}/low_authority.csv"),
-        format!("{dir}/low_authority.waypoints.csv"),
-        format!("{dir}/low_authority.toml"),
-    );
-    let out = run(&["--profile", &p, "--waypoints", &w, "--config", &c, "--json"]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let (p, w, c) = fixture("low_authority");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--config", &c, "--json"]);
     let total = v["total_J"].as_f64().unwrap();
     assert_eq!(v["safe"], true);
     assert!(total <= 1.10 * 4.169_39e7, "J {total} vs the best safe");
