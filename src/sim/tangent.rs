@@ -39,6 +39,16 @@ use super::lin::{EndAt, PieceLin, Sensitivity, StepLin};
 use super::watch::Watch;
 use super::{Scenario, SimError, TrackScore, VehicleState};
 
+/// Below this, a column's settled state is taken for zero (m/m for the
+/// depth, deg/m for the pitch loop's states and the integrators' terms):
+/// four orders under what f32 resolves of a column's response to its own
+/// track (about 1 m/m in depth), so that dropping it changes no gradient
+/// by more than its rounding (see [`Column::settle`]).
+const NEGLIGIBLE: f32 = 1e-7;
+
+/// Columns look for sleep every this many steps (a power of two).
+const SETTLE_EVERY: u32 = 8;
+
 /// The tangent of the state with respect to one reference depth, and the
 /// gradients it accumulates.
 #[derive(Clone, Copy)]
@@ -52,6 +62,9 @@ struct Column<const N: usize> {
     pitch_integral: f32,
     grad_j: f32,
     grad_violation: f32,
+    /// Asleep (see [`Column::step`]): the state is held, only the scores'
+    /// tangents accumulate.
+    asleep: bool,
 }
 
 impl<const N: usize> Column<N> {
@@ -88,6 +101,8 @@ impl<const N: usize> Column<N> {
 struct Tangents<'w, 'a, const N: usize, const K: usize> {
     cols: [Column<N>; K],
     gains: Gains<N>,
+    /// Steps taken (for [`SETTLE_EVERY`]).
+    tick: u32,
     /// Whether the watch records anything (read once).
     watching: bool,
     watch: &'w mut Watch<'a, K>,
@@ -138,11 +153,16 @@ struct Factors {
     pitch_integral: f32,
     dd: f32,
     dx: f32,
+    /// The depth loop reaches the pitch loop (the pitch reference is
+    /// unclamped or the depth integrator integrates).
+    open: bool,
+    /// Whether the awake columns look for sleep after this step.
+    check: bool,
 }
 
 impl Factors {
     #[inline(always)]
-    fn of<const N: usize>(g: &Gains<N>, lin: &StepLin) -> Self {
+    fn of<const N: usize>(g: &Gains<N>, lin: &StepLin, check: bool) -> Self {
         let c = lin.command;
         let on = |b: bool, v: f32| if b { v } else { 0.0 };
         let half = 0.5 * DEG * lin.step;
@@ -153,6 +173,8 @@ impl Factors {
             pitch_integral: on(c.pitch_integrating, g.ts),
             dd: half * lin.cos,
             dx: half * lin.sin,
+            open: c.pitch_ref_linear || c.depth_integrating,
+            check,
         }
     }
 }
@@ -162,8 +184,62 @@ impl<const N: usize> Column<N> {
     /// integrators as factors, so no branch), the plant's, the
     /// kinematics'; `driven` for the column of the active track, whose
     /// reference moves with its depth.
+    ///
+    /// A column asleep is held: its step is the identity (to within
+    /// [`NEGLIGIBLE`], see [`Column::settle`]) until the depth loop reaches
+    /// the pitch loop again with something to carry (the reference, where
+    /// driven, or its own depth or depth integral).
     #[inline(always)]
     fn step(&mut self, g: &Gains<N>, f: &Factors, driven: bool) {
+        if self.asleep {
+            let carries = driven || self.d != 0.0 || self.depth_integral != 0.0;
+            if !(f.open && carries) {
+                return;
+            }
+            self.asleep = false;
+        }
+        self.advance(g, f, driven);
+        if f.check {
+            self.settle(g, f, driven);
+        }
+    }
+
+    /// Puts the column to sleep where its step has become the identity to
+    /// within [`NEGLIGIBLE`]: the pitch loop's tangent has settled (the
+    /// plant's states, the pitch integrator's term and the depth's last
+    /// change all negligible) and either the depth loop does not reach the
+    /// pitch loop this step (a saturated dive or climb: the depth, its
+    /// integral and the along-track shift are held as they are) or the
+    /// column's track is over and its depth and depth integrator's term are
+    /// negligible too (the column has decayed: only the along-track shift
+    /// is left, held for good). The negligible residue is dropped.
+    #[inline(always)]
+    fn settle(&mut self, g: &Gains<N>, f: &Factors, driven: bool) {
+        let small = |v: f32| libm::fabsf(v) <= NEGLIGIBLE;
+        let quiet = self.eta.iter().all(|&v| small(v))
+            && small(g.pitch.1 * self.pitch_integral)
+            && small(self.d - self.d_prev);
+        if !quiet {
+            return;
+        }
+        let decayed = !driven && small(self.d) && small(g.ki * self.depth_integral);
+        if f.open && !decayed {
+            return;
+        }
+        self.eta = SVector::zeros();
+        self.pitch_integral = 0.0;
+        if decayed {
+            self.d = 0.0;
+            self.depth_integral = 0.0;
+        }
+        self.d_prev = self.d;
+        self.x_prev = self.x;
+        self.asleep = true;
+    }
+
+    /// The column's step proper (see [`Column::step`]).
+    #[inline(always)]
+    fn advance(&mut self, g: &Gains<N>, f: &Factors, driven: bool) {
         let (kp_t, ki_t, kd_t) = g.pitch;
         let pitch = self.eta.get(0).copied().unwrap_or(0.0);
         let pitch_rate = self.eta.get(1).copied().unwrap_or(0.0);
@@ -206,6 +282,7 @@ impl<'w, 'a, const N: usize, const K: usize> Tangents<'w, 'a, N, K> {
     /// The start state does not depend on `ζ`: every tangent is zero.
     fn zero(vehicle: &Vehicle<N>, watch: &'w mut Watch<'a, K>) -> Self {
         Self {
+            tick: 0,
             watching: watch.on(),
             watch,
             gains: Gains::of(vehicle),
@@ -219,15 +296,25 @@ impl<'w, 'a, const N: usize, const K: usize> Tangents<'w, 'a, N, K> {
                 pitch_integral: 0.0,
                 grad_j: 0.0,
                 grad_violation: 0.0,
+                asleep: false,
             }; K],
         }
+    }
+}
+
+impl<const N: usize, const K: usize> Tangents<'_, '_, N, K> {
+    /// This step's factors, counting it.
+    #[inline(always)]
+    fn factors(&mut self, lin: &StepLin) -> Factors {
+        self.tick = self.tick.wrapping_add(1);
+        Factors::of(&self.gains, lin, self.tick.is_multiple_of(SETTLE_EVERY))
     }
 }
 
 impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
     #[inline(always)]
     fn step(&mut self, _: &Vehicle<N>, lin: &StepLin) {
-        let f = Factors::of(&self.gains, lin);
+        let f = self.factors(lin);
         for (j, col) in self
             .cols
             .iter_mut()
@@ -254,7 +341,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
             self.piece(slot, p);
             return;
         }
-        let f = Factors::of(&self.gains, lin);
+        let f = self.factors(lin);
         let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
         let half = 0.5 * p.len;
         let (he_lo, he_hi) = (half * p.lo.e, half * p.hi.e);

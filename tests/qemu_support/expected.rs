@@ -176,14 +176,14 @@ pub const SMOKE: Smoke = Smoke {
     violation: f32::from_bits(0x431287a4) /* 146.52985 */,
     min_altitude: f32::from_bits(0x4260280a) /* 56.0391 */,
     grad_j: [
-        f32::from_bits(0xc636c093) /* -11696.144 */,
+        f32::from_bits(0xc636c097) /* -11696.147 */,
         f32::from_bits(0xc80f194a) /* -146533.16 */,
         f32::from_bits(0x00000000) /* 0.0 */,
         f32::from_bits(0x44f5317b) /* 1961.5463 */,
         f32::from_bits(0x436865ac) /* 232.39716 */,
     ],
     grad_violation: [
-        f32::from_bits(0xba8e0756) /* -0.0010835927 */,
+        f32::from_bits(0xba8e0b2e) /* -0.0010837072 */,
         f32::from_bits(0xbacf3a7f) /* -0.001581028 */,
         f32::from_bits(0x00000000) /* 0.0 */,
         f32::from_bits(0x42cf0d92) /* 103.526505 */,
