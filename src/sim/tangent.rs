@@ -494,8 +494,10 @@ impl<const N: usize> Scenario<'_, N> {
     }
 
     /// [`Scenario::evaluate_watched`], with the columns' sleep allowed or
-    /// not; also returns how many columns end the pass asleep.
-    #[inline(always)]
+    /// not; also returns how many columns end the pass asleep. The one
+    /// copy of the tangent pass's loop (out of line, so that the callers'
+    /// own inlining does not copy it).
+    #[inline(never)]
     fn evaluate_settling<const K: usize>(
         &self,
         start: &VehicleState<N>,
