@@ -480,7 +480,9 @@ impl<const N: usize> Scenario<'_, N> {
     /// As [`Scenario::evaluate_tracks`].
     ///
     /// The one tangent pass of the library: the plain gradient is this
-    /// pass with [`Watch::off`] (one copy of the loop in the firmware).
+    /// pass with [`Watch::off`] (one copy of the loop in the firmware: out
+    /// of line, so that no caller's inlining copies it).
+    #[inline(never)]
     pub(crate) fn evaluate_watched<const K: usize>(
         &self,
         start: &VehicleState<N>,
@@ -489,26 +491,24 @@ impl<const N: usize> Scenario<'_, N> {
         count: usize,
         watch: &mut Watch<'_, K>,
     ) -> Result<Evaluation<N, K>, SimError> {
-        self.evaluate_settling(start, (first_track, depths, count), watch, true)
+        self.evaluate_settling::<K, true>(start, (first_track, depths, count), watch)
             .map(|(e, _)| e)
     }
 
-    /// [`Scenario::evaluate_watched`], with the columns' sleep allowed or
-    /// not; also returns how many columns end the pass asleep. The one
-    /// copy of the tangent pass's loop (out of line, so that the callers'
-    /// own inlining does not copy it).
-    #[inline(never)]
-    fn evaluate_settling<const K: usize>(
+    /// [`Scenario::evaluate_watched`], with the columns' sleep allowed
+    /// (`SETTLE`) or not (for the test that compares); also returns how
+    /// many columns end the pass asleep.
+    #[inline(always)]
+    fn evaluate_settling<const K: usize, const SETTLE: bool>(
         &self,
         start: &VehicleState<N>,
         (first_track, depths, count): (usize, &[f32; K], usize),
         watch: &mut Watch<'_, K>,
-        settling: bool,
     ) -> Result<(Evaluation<N, K>, usize), SimError> {
         let used = depths.get(..count).ok_or(SimError::TrackRange)?;
         let mut scores = [TrackScore::default(); K];
         let mut tan = Tangents::zero(self.vehicle, watch);
-        tan.settling = settling;
+        tan.settling = SETTLE;
         let end =
             self.run::<_, _, true>(start, first_track, used, &mut scores, &mut tan, |_| {})?;
         let asleep = tan.cols.iter().filter(|c| c.asleep).count();
@@ -585,11 +585,10 @@ mod tests {
                 let at = ((n * 8 + 4) as f32 * 100.0).min(3900.0);
                 bottom.depth_at(at).unwrap() - 60.0 - 80.0 * rng.next()
             });
-            let run = |settling| {
-                let mut off = Watch::off();
-                sc.evaluate_settling(&start, (0, &z, 5), &mut off, settling)
-            };
-            let (Ok((slept, n)), Ok((awake, m))) = (run(true), run(false)) else {
+            let (mut off, mut off2) = (Watch::off(), Watch::off());
+            let slept = sc.evaluate_settling::<5, true>(&start, (0, &z, 5), &mut off);
+            let awake = sc.evaluate_settling::<5, false>(&start, (0, &z, 5), &mut off2);
+            let (Ok((slept, n)), Ok((awake, m))) = (slept, awake) else {
                 continue;
             };
             assert_eq!(m, 0, "case {case}");
