@@ -25,7 +25,10 @@
 //! along the segment, `∂e = −[(1−t)(∂d0 − Δd/Δx ∂x0) + t (∂d1 − Δd/Δx ∂x1)]`.
 //!
 //! This is the gradient of the discrete simulation itself, exact up to f32
-//! rounding, wherever the simulation is differentiable: it is not defined
+//! rounding (and the residue below `NEGLIGIBLE` = 1e-7 that a sleeping
+//! column drops: see `Column::settle`; within 1e-5 of the largest entry
+//! against columns kept awake, by the test below), wherever the
+//! simulation is differentiable: it is not defined
 //! at the isolated depths where a sample lands exactly on a waypoint or a
 //! clamp's edge, and it is exactly zero on the plateaus where the pitch
 //! reference stays saturated over a whole track (contract §10).
