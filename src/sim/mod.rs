@@ -10,14 +10,19 @@
 //! | `score.rs` | [`TrackScore`] and the one scoring kernel |
 //! | `lin.rs` | what a step and a scored piece linearize to |
 //! | `tangent.rs` | tangent states: [`Evaluation`], `∂J/∂z` by forward sensitivity |
+//! | `column.rs` | one tangent column: its step, its sleep where the step is the identity, the pieces it scores |
 //! | `watch.rs` | what a tangent pass records for the SQP: segments' least altitudes, Gauss–Newton |
 //! | `estimate.rs` | [`Measurement`]; the start state from what the vehicle measures |
 //! | `world.rs` | [`World`]: true speed, flight-path offset, vertical current |
 //! | `error.rs` | [`SimError`] |
+//! | `rng.rs` | (tests only) the randomized tests' generator |
 
+mod column;
 mod error;
 mod estimate;
 mod lin;
+#[cfg(test)]
+mod rng;
 mod run;
 mod score;
 mod state;

@@ -514,17 +514,7 @@ mod tests {
     //! equal to their summation's rounding.
     use super::*;
     use crate::model::{Mission, Profile, Vehicle, Waypoints};
-
-    struct Lcg(u64);
-    impl Lcg {
-        fn next(&mut self) -> f32 {
-            self.0 = self
-                .0
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1_442_695_040_888_963_407);
-            (self.0 >> 40) as f32 / (1u64 << 24) as f32
-        }
-    }
+    use crate::sim::rng::Lcg;
 
     #[test]
     fn fast_path_equals_general_path_on_random_flights() {
