@@ -1066,6 +1066,28 @@ fn a_plateau_left_after_another_jump() {
     );
 }
 
+/// The SQP ends no worse than the best feasible point it passed: on a
+/// random canyon line (`tools/reference/check_planner.py --unseen 8 --seed
+/// 90317`, `unseen_90317_1`) the cold horizon started feasible at `J`
+/// 1.07e8 m³ (the beam's plan), stepped out of the feasible set to 4.5e7
+/// under a still small merit weight and came back at 3.78e8 m³, track 3
+/// held on a climb 356 m above a deep bottom: the line's `J` 3.779e8 m³,
+/// 4.56× the f64 beam search's best safe plan (8.27996e7 m³: 361.2,
+/// 937.8, 1 344.8, 752.5, 1 032.7 m). Back at its best feasible iterate
+/// and restarted there with the merit weight it had learnt, 8.37e7. The
+/// checker's bound is 1.10×.
+#[test]
+fn the_sqp_ends_no_worse_than_its_best_feasible_point() {
+    let (p, w, _) = fixture("best_feasible");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.10 * 8.27996e7,
+        "J {total} vs the best safe 8.27996e7"
+    );
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200

@@ -88,6 +88,61 @@ pub(crate) fn backward<const K: usize>(l: &Mat<K>, y: &[f32; K], n: usize) -> [f
     x
 }
 
+/// Powell's damped BFGS update of `a` for step `s` and Lagrangian gradient
+/// change `y` over the first `n` variables; returns whether it was made.
+pub(crate) fn damped_update<const K: usize>(
+    a: &mut Mat<K>,
+    s: &[f32; K],
+    y: &[f32; K],
+    n: usize,
+) -> bool {
+    let bs = mul(a, s, n);
+    let sbs = dot(s, &bs, n);
+    let sy = dot(s, y, n);
+    if !(sbs > 0.0 && sbs.is_finite() && sy.is_finite()) {
+        return false;
+    }
+    let theta = if sy >= 0.2 * sbs {
+        1.0
+    } else {
+        0.8 * sbs / (sbs - sy)
+    };
+    let r: [f32; K] = core::array::from_fn(|i| {
+        theta * y.get(i).copied().unwrap_or(0.0) + (1.0 - theta) * bs.get(i).copied().unwrap_or(0.0)
+    });
+    let sr = dot(s, &r, n);
+    if sr.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+        return false;
+    }
+    let mut next = *a;
+    for i in 0..n {
+        for j in 0..n {
+            let (ri, rj) = (
+                r.get(i).copied().unwrap_or(0.0),
+                r.get(j).copied().unwrap_or(0.0),
+            );
+            let (bi, bj) = (
+                bs.get(i).copied().unwrap_or(0.0),
+                bs.get(j).copied().unwrap_or(0.0),
+            );
+            put(&mut next, i, j, at(a, i, j) + ri * rj / sr - bi * bj / sbs);
+        }
+    }
+    if !next.iter().flatten().all(|v| v.is_finite()) {
+        return false;
+    }
+    // Symmetric against rounding.
+    for i in 0..n {
+        for j in 0..i {
+            let m = 0.5 * (at(&next, i, j) + at(&next, j, i));
+            put(&mut next, i, j, m);
+            put(&mut next, j, i, m);
+        }
+    }
+    *a = next;
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,6 +12,7 @@
 //! backtracking cap in [`mod@armijo`], the step cap in [`BfgsConfig`].
 
 pub mod armijo;
+pub(crate) mod best;
 pub mod bfgs;
 pub(crate) mod constrained;
 pub(crate) mod dense;

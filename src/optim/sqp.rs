@@ -38,12 +38,14 @@
 //! one whose merit stayed unmoved [`STALLS`] iterations in a row: on a
 //! random line (`unseen_11_1` of `check_planner.py --seed 11`) the runs
 //! stopped infeasible and the line's `J` was 1.32× the best safe; with the
-//! restoration, 1.002×.
+//! restoration, 1.002×. A run never ends worse than the best feasible
+//! point it linearized (`best.rs`).
 
 use heapless::Vec;
 
+use super::best::BestFeasible;
 pub(crate) use super::constrained::{CONSTRAINTS, Constrained, Linearized};
-use super::dense::{Mat, at, dot, mul, put};
+use super::dense::{Mat, at, damped_update, dot, mul, put};
 use super::qp::{self, QP_ROWS, QpError, Row, Rows};
 use super::{BfgsConfig, Bounds, OptimError, Outcome, Status, Vector};
 
@@ -82,7 +84,10 @@ const STALLS: u32 = 5;
 /// each iterate appended to `out.history` (not monotone: an early iterate
 /// may be infeasible, and lower). `metric`: the first metric when given
 /// (a restart near a finished run keeps its curvature), else the
-/// Gauss–Newton matrix at `z0`; the final metric on return. Returns the
+/// Gauss–Newton matrix at `z0`; the final metric on return. `rho0`: the
+/// merit weight to start from (m³/m; 0 learns it from the multipliers).
+/// A run that ends infeasible or worse than its best feasible iterate
+/// goes back to that iterate (`best.rs`). Returns the
 /// ℓ1 merit's final penalty weight and any row active at a one-sided kink
 /// at the end ([`SqpEnd`]).
 ///
@@ -90,7 +95,7 @@ const STALLS: u32 = 5;
 /// [`OptimError`] when the objective fails or is not finite at the start.
 pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     obj: &mut O,
-    (z0, metric): (&[f32; K], &mut Option<Mat<K>>),
+    (z0, metric, rho0): (&[f32; K], &mut Option<Mat<K>>, f32),
     (bounds, n): (&Bounds<K>, usize),
     cfg: &BfgsConfig,
     feas_tol: f32,
@@ -105,7 +110,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         z: bounds.project(z0),
         lin: Linearized::default(),
         a: [[0.0; K]; K],
-        rho: 0.0,
+        rho: rho0.max(0.0),
         evaluations: 1,
         iterations: 0,
         skipped: 0,
@@ -119,6 +124,8 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     run.a = initial_metric(metric.as_ref().unwrap_or(&run.lin.gn), n);
     let _ = out.history.push(run.lin.j);
     let mut restorations = 0;
+    let mut best = BestFeasible::default();
+    best.see(&run.z, &run.lin, feas_tol);
     let status = loop {
         if run.iterations >= cfg.max_iterations {
             break Status::MaxIterations;
@@ -138,11 +145,16 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         // One value per completed iteration, the last included.
         if run.iterations != before {
             let _ = out.history.push(run.lin.j);
+            best.see(&run.z, &run.lin, feas_tol);
         }
         if let Some(stop) = stop {
             break stop;
         }
     };
+    let returned = best.return_to(obj, (&mut run.z, &mut run.lin), (feas_tol, &cfg.tol));
+    if returned {
+        run.evaluations = run.evaluations.saturating_add(1);
+    }
     let z = Vector::from(run.z);
     out.z = run.z;
     out.j = run.lin.j;
@@ -156,6 +168,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     Ok(SqpEnd {
         rho: run.rho,
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
+        returned,
     })
 }
 
@@ -168,6 +181,9 @@ pub(crate) struct SqpEnd {
     /// The group of a row active at a one-sided kink at the end
     /// ([`Linearized::kinked`]), if any.
     pub kink: Option<usize>,
+    /// Whether the run went back to its best feasible iterate
+    /// (`best.rs`).
+    pub returned: bool,
 }
 
 /// How close to zero (m) a row's `c` counts as active at the end: the
@@ -254,7 +270,7 @@ impl<const K: usize> Run<K> {
         let y: [f32; K] = core::array::from_fn(|i| {
             new.get(i).copied().unwrap_or(0.0) - old.get(i).copied().unwrap_or(0.0)
         });
-        if !update(&mut self.a, &s, &y, n) {
+        if !damped_update(&mut self.a, &s, &y, n) {
             self.skipped = self.skipped.saturating_add(1);
         }
         self.z = zt;
@@ -542,54 +558,4 @@ fn search<const K: usize, O: Constrained<K>>(
         alpha = next.min(0.5 * alpha).max(0.1 * alpha);
     }
     (None, tried)
-}
-
-/// Powell's damped BFGS update of `a` for step `s` and Lagrangian gradient
-/// change `y` over the first `n` variables; returns whether it was made.
-fn update<const K: usize>(a: &mut Mat<K>, s: &[f32; K], y: &[f32; K], n: usize) -> bool {
-    let bs = mul(a, s, n);
-    let sbs = dot(s, &bs, n);
-    let sy = dot(s, y, n);
-    if !(sbs > 0.0 && sbs.is_finite() && sy.is_finite()) {
-        return false;
-    }
-    let theta = if sy >= 0.2 * sbs {
-        1.0
-    } else {
-        0.8 * sbs / (sbs - sy)
-    };
-    let r: [f32; K] = core::array::from_fn(|i| {
-        theta * y.get(i).copied().unwrap_or(0.0) + (1.0 - theta) * bs.get(i).copied().unwrap_or(0.0)
-    });
-    let sr = dot(s, &r, n);
-    if sr.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
-        return false;
-    }
-    let mut next = *a;
-    for i in 0..n {
-        for j in 0..n {
-            let (ri, rj) = (
-                r.get(i).copied().unwrap_or(0.0),
-                r.get(j).copied().unwrap_or(0.0),
-            );
-            let (bi, bj) = (
-                bs.get(i).copied().unwrap_or(0.0),
-                bs.get(j).copied().unwrap_or(0.0),
-            );
-            put(&mut next, i, j, at(a, i, j) + ri * rj / sr - bi * bj / sbs);
-        }
-    }
-    if !next.iter().flatten().all(|v| v.is_finite()) {
-        return false;
-    }
-    // Symmetric against rounding.
-    for i in 0..n {
-        for j in 0..i {
-            let m = 0.5 * (at(&next, i, j) + at(&next, j, i));
-            put(&mut next, i, j, m);
-            put(&mut next, j, i, m);
-        }
-    }
-    *a = next;
-    true
 }

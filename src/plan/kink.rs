@@ -38,7 +38,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> u32 {
         match self.kink_start(obj, bounds, g) {
             Ok(Some(z)) => self
-                .sqp_restart(obj, &z, (h, bounds), tol, iterations)
+                .sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations)
                 .unwrap_or(iterations),
             Ok(None) | Err(_) => iterations,
         }

@@ -148,7 +148,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut metric = None;
         let run = sqp_into(
             obj,
-            (z0, &mut metric),
+            (z0, &mut metric, 0.0),
             (bounds, h),
             &self.cfg.bfgs,
             tol,
@@ -162,6 +162,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let end = run.map_err(start_error)?;
         let rho = end.rho;
         let mut iterations = self.work.iterations;
+        // Back at its best feasible iterate (`optim/best.rs`): once more from
+        // there, with the merit weight learnt.
+        if end.returned && iterations < self.cfg.bfgs.max_iterations {
+            let z = self.work.z;
+            let again = self.sqp_restart(obj, &z, (h, bounds), (tol, rho), iterations);
+            iterations = again.unwrap_or(iterations);
+        }
         let mut scanned = 0_u64;
         // The coordinates a kept restart jumped: the next round scans the
         // others again (the restart moved the point, and a plateau's best
@@ -192,7 +199,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 }
             }
             let Some((_, z, bit)) = best else { break };
-            match self.sqp_restart(obj, &z, (h, bounds), tol, iterations) {
+            match self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations) {
                 Some(total) => iterations = total,
                 None => break,
             }
@@ -210,16 +217,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         Ok((iterations, scanned | skip))
     }
 
-    /// The SQP restarted from `z` (a plateau's scan point), kept if it
-    /// ends better than the workspace's: feasible and lower, or, from an
-    /// infeasible optimum, less infeasible. Returns the iterations so far
-    /// when kept.
+    /// The SQP restarted from `z` with the merit weight `rho` (m³/m; 0:
+    /// learnt afresh), kept if it ends better than the workspace's: feasible
+    /// and lower, or, from an infeasible optimum, less infeasible. Returns
+    /// the iterations so far when kept.
     pub(super) fn sqp_restart(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         z: &[f32; K],
         (h, bounds): (usize, &Bounds<K>),
-        tol: f32,
+        (tol, rho): (f32, f32),
         iterations: u32,
     ) -> Option<u32> {
         let kept = self.work.mark();
@@ -239,7 +246,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut fresh = None;
         let restart = sqp_into(
             obj,
-            (z, &mut fresh),
+            (z, &mut fresh, rho),
             (bounds, h),
             &left,
             tol,
