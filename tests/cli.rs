@@ -1088,6 +1088,26 @@ fn the_sqp_ends_no_worse_than_its_best_feasible_point() {
     );
 }
 
+/// A later track held at its target by the depth before it: on a random
+/// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 60606`,
+/// `unseen_60606_0`) the cold SQP ended with track 1 at 662.6 m (a
+/// saturated dive, zero gradient) and track 2 at its least altitude's
+/// target at 661.1 m: the line's `J` 2.394e7 m³, 1.56× the f64 beam
+/// search's best safe plan (1.534436e7 m³: 587.0, 922.1, 575.0, 504.9,
+/// 801.5 m), which flies track 1 shallower so that track 2 can dive.
+/// With `lift.rs`, 1.001×. The checker's bound is 1.10×.
+#[test]
+fn a_later_track_dives_once_the_one_before_is_lifted() {
+    let (p, w, _) = fixture("lift_earlier");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.10 * 1.534436e7,
+        "J {total} vs the best safe 1.534436e7"
+    );
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200

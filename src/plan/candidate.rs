@@ -208,6 +208,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // Under declared uncertainty, unbudgeted: the targets raised by the
         // certification gaps (the last calls' first, `gaps.rs`).
         let certifying = self.cfg.constrained && self.budget.limit == u32::MAX;
+        let declared = *m.uncertainty() != crate::model::Uncertainty::NONE;
         let mut gaps = [0.0_f32; K];
         if certifying {
             for (dst, src) in gaps.iter_mut().zip(self.gaps.iter().skip(fl.track)) {
@@ -224,7 +225,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // declared uncertainty the certificate's worlds and vehicle
             // margin hold it instead, and a later call then finds the same
             // continuation (and keeps it, `commit.rs`).
-            let declared = *m.uncertainty() != crate::model::Uncertainty::NONE;
             let later = if declared {
                 0.0
             } else {
@@ -251,6 +251,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let (h, mu) = (s.h, s.mu);
             let at = (tol, s.h_safe, iterations);
             iterations = self.wider_start((&mut obj, fl, scan), (h, &s.bounds, mu), at);
+            // (Not under declared uncertainty: there every later track's
+            // target is `h_a + m_s`, most of them are at it, and the
+            // escape's restarts cost Monterey 1's certified cold call
+            // +27 %, the line over its 800 M instructions: BENCHMARKS.md.)
+            if !declared {
+                iterations = self.lift_earlier(&mut obj, (h, &s.bounds), tol, iterations);
+            }
         }
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {

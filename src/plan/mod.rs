@@ -142,6 +142,7 @@ mod fallback;
 mod flights;
 mod gaps;
 mod kink;
+mod lift;
 mod objective;
 mod planner;
 mod plateau;

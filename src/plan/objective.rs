@@ -208,6 +208,28 @@ impl<const N: usize> PlanObjective<'_, N> {
         Ok(flown.min_altitude())
     }
 
+    /// Tracks `j..=g` of the horizon flown at `z` from `at_j`, the state
+    /// track `j` starts in: track `g`'s least altitude, m. One flight,
+    /// counted.
+    pub fn least_at<const K: usize>(
+        &mut self,
+        (at_j, j): (&VehicleState<N>, usize),
+        z: &[f32; K],
+        g: usize,
+    ) -> Result<f32, Stop> {
+        self.count_flight()?;
+        let used = z.get(j..=g).ok_or(Stop::Sim(SimError::TrackRange))?;
+        let mut scores = [TrackScore::default(); K];
+        let flown = scores
+            .get_mut(..used.len())
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        self.sc
+            .fly(at_j, self.track.saturating_add(j), used, flown)
+            .map_err(Stop::Sim)?;
+        let last = flown.last().ok_or(Stop::Sim(SimError::TrackRange))?;
+        Ok(last.min_altitude())
+    }
+
     /// `(Σ J, v)` of the horizon's `scores` (m³, m): a non-finite `J` is
     /// a diverged flight.
     fn value_of(&self, scores: &[TrackScore]) -> Result<(f32, f32), Stop> {
