@@ -1108,6 +1108,28 @@ fn a_later_track_dives_once_the_one_before_is_lifted() {
     );
 }
 
+/// A climb bought for a dive: on a random canyon line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 90317`,
+/// `unseen_90317_0`) track 4 crosses a rise 130 m above its deep end. The
+/// cold SQP held track 4 at the rise's target (975 m, `J` 7.58e6 m³); a
+/// lift of track 3 alone could not free it, because the climb saturates.
+/// The best safe plan (the f64 beam search: 1069.8, 1063.7, 766.4,
+/// 1225.5 m, line `J` 3.282938e6 m³) climbs on track 3, so that track 4
+/// can dive from higher and pass the rise 60 m above it. Before
+/// `lift.rs` sought track 4's preferred depth, 2.77×; now 1.001×. The
+/// checker's bound is 1.10×.
+#[test]
+fn a_track_climbs_so_that_the_next_can_dive_past_a_rise() {
+    let (p, w, _) = fixture("lift_to_dive");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.10 * 3.282938e6,
+        "J {total} vs the best safe 3.282938e6"
+    );
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200

@@ -8,21 +8,35 @@
 //! single-depth scan gains) and track 2 at its target at 661.1 m; the best
 //! safe plan flies track 1 at 587 m so that track 2 can dive to 922 m. The
 //! line's `J` was 1.56× the f64 search's best safe plan; after, 1.001×
-//! (`unseen_5151_6`: 1.33× → 1.002×). The escape, for each later track
-//! `g` at its target: depth `g − 1` lifted by the band `h_r − h_a`,
-//! doubling (at most [`LIFTS`] times, within the box), until track `g`'s
-//! least altitude clears its target by the band (one flight of the two
-//! tracks each); depth `g` then deepened by what was freed beyond the
-//! band, and the SQP restarted from there where the horizon's `J` is
-//! lower (one flight of the tail), kept only if it ends better.
+//! (`unseen_5151_6`: 1.33× → 1.002×).
+//!
+//! The escape, for each later track `g` at its target: depth `g − 1`
+//! lifted by the band `h_r − h_a`, doubling (at most [`LIFTS`] times,
+//! within the box). At each lift, track `g`'s least altitude is measured
+//! at its own depth (one flight of the two tracks): where it clears the
+//! target by the band, depth `g` is deepened by what was freed beyond the
+//! band. Where it does not, and track `g` is held more than the band
+//! above its preferred depth (its bottom's mean less `h_r`), the lift that
+//! lets track `g` fly its preferred depth is sought instead: a dive from
+//! a shallower start passes a rise of the bottom higher, so a climb on
+//! track `g − 1` can buy a deep track `g` (`unseen_90317_0`, where the
+//! best plan climbs 209 m on track 3 to fly track 4 250 m deeper). The
+//! least such lift found by doubling is narrowed by [`NARROW`] bisections
+//! (one flight each). Either start is flown whole (one flight of the
+//! tail) and the SQP restarted from it where the horizon's `J` is lower,
+//! kept only if it ends better.
 
 use crate::optim::Bounds;
+use crate::sim::{Scenario, VehicleState};
 
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
 
 /// Lifts tried for one track (the band, doubling).
 const LIFTS: u32 = 6;
+
+/// Bisections of the least lift that frees a track's preferred depth.
+const NARROW: u32 = 3;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The escape of the module docs over a horizon of `h` tracks in
@@ -35,7 +49,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         obj: &mut PlanObjective<'_, N>,
         (h, bounds): (usize, &Bounds<K>),
         tol: f32,
-        iterations: u32,
+        mut iterations: u32,
     ) -> u32 {
         if obj.last_violation > tol || iterations >= self.cfg.bfgs.max_iterations {
             return iterations;
@@ -45,7 +59,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 continue;
             };
             if let Some(total) = self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations) {
-                return total;
+                iterations = total;
+                if iterations >= self.cfg.bfgs.max_iterations {
+                    break;
+                }
             }
         }
         iterations
@@ -53,7 +70,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The restart point for later track `g`: `None` unless `g` is at its
     /// target (within the band's hundredth, or `tol`, m) and a lift of
-    /// track `g − 1` frees it.
+    /// track `g − 1` frees it where the horizon's `J` is lower.
     fn lift_start(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -61,40 +78,168 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         g: usize,
         tol: f32,
     ) -> Result<Option<[f32; K]>, Stop> {
-        let m = obj.sc.mission();
-        let band = m.reference_altitude() - m.min_altitude();
+        let h_r = obj.sc.mission().reference_altitude();
+        let band = h_r - obj.sc.mission().min_altitude();
+        let slack = tol.max(0.01 * band);
         let j = g.saturating_sub(1);
-        let mut z = self.work.z;
+        let z = self.work.z;
         let (head, at_j) = obj.head(&z, j)?;
         let target = obj.target_of(g);
-        let least = obj.least_at((&at_j, j), &z, g)?;
-        if least > target + tol.max(0.01 * band) {
+        if obj.least_at((&at_j, j), &z, g)? > target + slack {
             return Ok(None);
         }
-        let (Some(&zj), Some(&lo)) = (z.get(j), bounds.lo.get(j)) else {
+        let (Some(&zj), Some(&zg), Some(&lo), Some(&hi)) =
+            (z.get(j), z.get(g), bounds.lo.get(j), bounds.hi.get(g))
+        else {
             return Ok(None);
         };
-        let mut lift = band;
+        let l = Lift {
+            at_j,
+            j,
+            g,
+            zj,
+            zg,
+            lo,
+            target,
+            band,
+            slack,
+            // Track `g`'s preferred depth, where it is held more than the
+            // band above it.
+            deep: preferred(&obj.sc, obj.track.saturating_add(g), h_r)
+                .map(|p| p.min(hi))
+                .filter(|&p| p > zg + band),
+        };
+        let start = match l.search(obj, z)? {
+            Next::Freed(start) => start,
+            Next::Deep(lifts) => l.narrowed(obj, z, lifts)?,
+            Next::Nothing => return Ok(None),
+        };
+        let (jz, _) = obj.tail_value(&head, (&at_j, j), &start)?;
+        Ok((jz < self.work.j).then_some(start))
+    }
+}
+
+/// What is fixed while one later track's lift is sought.
+struct Lift<const N: usize> {
+    /// The state track `j` starts in.
+    at_j: VehicleState<N>,
+    /// The lifted track and the later one.
+    j: usize,
+    g: usize,
+    /// Their depths as the SQP left them, and depth `j`'s box floor, m.
+    zj: f32,
+    zg: f32,
+    lo: f32,
+    /// Track `g`'s target altitude, the band `h_r − h_a` and the altitude
+    /// that counts as a gain, m.
+    target: f32,
+    band: f32,
+    slack: f32,
+    /// Track `g`'s preferred depth where it is held above it, m.
+    deep: Option<f32>,
+}
+
+/// What the lifts by doubling found.
+enum Next<const K: usize> {
+    /// A start with track `g` deepened by the altitude freed.
+    Freed([f32; K]),
+    /// The lifts `(held, free)` (m) between which track `g` at its
+    /// preferred depth first clears its target (`free` feasible), or
+    /// `(held, held)` where the climb saturates first.
+    Deep((f32, f32)),
+    Nothing,
+}
+
+impl<const N: usize> Lift<N> {
+    /// Depth `j` lifted by the band, doubling: one or two flights of the
+    /// two tracks per lift.
+    fn search<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        mut z: [f32; K],
+    ) -> Result<Next<K>, Stop> {
+        let (j, g) = (self.j, self.g);
+        let mut lift = self.band;
+        let mut held = 0.0;
+        // Track `g`'s least altitude at its preferred depth, last lift, m.
+        let mut last = f32::NEG_INFINITY;
         for _ in 0..LIFTS {
-            let up = crate::num::max(zj - lift, lo);
-            if let Some(v) = z.get_mut(j) {
-                *v = up;
-            }
-            let freed = obj.least_at((&at_j, j), &z, g)? - target - band;
+            let up = crate::num::max(self.zj - lift, self.lo);
+            set(&mut z, j, up);
+            set(&mut z, g, self.zg);
+            let freed = obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band;
             if freed >= 0.0 {
-                // Track `g` given the freed altitude: kept only where the
-                // horizon's `J` falls (and it stays within the band).
-                if let Some(v) = z.get_mut(g) {
-                    *v += freed;
-                }
-                let (jz, v) = obj.tail_value(&head, (&at_j, j), &z)?;
-                return Ok((v <= band && jz < self.work.j).then_some(z));
+                set(&mut z, g, self.zg + freed);
+                return Ok(Next::Freed(z));
             }
-            if up <= lo {
+            if let Some(p) = self.deep {
+                set(&mut z, g, p);
+                let a = obj.least_at((&self.at_j, j), &z, g)?;
+                if a >= self.target {
+                    return Ok(Next::Deep((held, self.zj - up)));
+                }
+                if a <= last + self.slack {
+                    // The climb saturates: no lift frees more.
+                    return Ok(Next::Deep((held, held)));
+                }
+                last = a;
+            }
+            if up <= self.lo {
                 break;
             }
+            held = self.zj - up;
             lift *= 2.0;
         }
-        Ok(None)
+        Ok(Next::Nothing)
     }
+
+    /// The start at track `g`'s preferred depth with the least lift in
+    /// `(held, free]` that frees it, by [`NARROW`] bisections (one flight
+    /// of the two tracks each) where `free > held`.
+    fn narrowed<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        mut z: [f32; K],
+        (mut held, mut free): (f32, f32),
+    ) -> Result<[f32; K], Stop> {
+        let p = self.deep.unwrap_or(self.zg);
+        set(&mut z, self.g, p);
+        if free > held {
+            for _ in 0..NARROW {
+                let mid = 0.5 * (held + free);
+                set(&mut z, self.j, self.zj - mid);
+                if obj.least_at((&self.at_j, self.j), &z, self.g)? >= self.target {
+                    free = mid;
+                } else {
+                    held = mid;
+                }
+            }
+        }
+        set(&mut z, self.j, self.zj - free);
+        Ok(z)
+    }
+}
+
+/// Sets `z[i]` where it exists.
+fn set<const K: usize>(z: &mut [f32; K], i: usize, v: f32) {
+    if let Some(x) = z.get_mut(i) {
+        *x = v;
+    }
+}
+
+/// The preferred depth of line track `t`: the mean of its bottom samples
+/// less the reference altitude `h_r` (m); `None` without samples.
+fn preferred<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
+    let wp = sc.waypoints().positions();
+    let (&a, &b) = (wp.get(t)?, wp.get(t.saturating_add(1))?);
+    let p = sc.profile();
+    let (sum, n) = p
+        .positions()
+        .iter()
+        .zip(p.depths())
+        .filter(|&(&x, _)| x >= a && x <= b)
+        .fold((0.0_f32, 0_u32), |(s, n), (_, &d)| {
+            (s + d, n.saturating_add(1))
+        });
+    (n > 0).then(|| sum / n as f32 - h_r)
 }
