@@ -1130,6 +1130,27 @@ fn a_track_climbs_so_that_the_next_can_dive_past_a_rise() {
     );
 }
 
+/// A metric no longer definite in f32: on a random canyon line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 60606`,
+/// `unseen_60606_2`) tracks 2–4 are saturated dives. One BFGS update left
+/// the cold call's metric with eigenvalues −4e−4 and 1e−4 beside 1.6e3,
+/// the QP refused it, and the run stopped with track 1 at 554.6 m, 12 m
+/// short of its boundary: line `J` 1.893e7 m³, 1.16× the f64 beam
+/// search's best safe plan (1.626596e7 m³: 566.6, 906.1, 1077.5, 1428.2,
+/// 1359.2 m). With the metric reset to its diagonal, 1.0002×
+/// (`unseen_5151_3`: 1.15× → 0.9997×). The checker's bound is 1.10×.
+#[test]
+fn an_indefinite_metric_is_reset_not_the_end_of_the_run() {
+    let (p, w, _) = fixture("indefinite_metric");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.10 * 1.626596e7,
+        "J {total} vs the best safe 1.626596e7"
+    );
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200
