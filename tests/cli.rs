@@ -1151,6 +1151,27 @@ fn an_indefinite_metric_is_reset_not_the_end_of_the_run() {
     );
 }
 
+/// A kink far from its way out: on a random line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 2718`,
+/// `unseen_2718_2`) the cold SQP ended with track 5 diving 425 m
+/// saturated from 515 m (its own column zero) and track 4 held 156 m above
+/// its bottom by track 5's least altitude: line `J` 3.222e6 m³, 1.61× the
+/// f64 beam search's best safe plan (1.99653e6 m³: 465.7, 485.6, 585.4,
+/// 621.4, 670.3 m). Moving track 5 up by `h_r − h_a` lifted nothing; the
+/// cold call's doubled moves unsaturate it at 320 m, and the restart
+/// finds 1.001×. The checker's bound is 1.10×.
+#[test]
+fn a_cold_kink_escape_moves_as_far_as_the_dive_needs() {
+    let (p, w, _) = fixture("kink_far");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.10 * 1.99653e6,
+        "J {total} vs the best safe 1.99653e6"
+    );
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200

@@ -245,8 +245,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             self.seed_gaps(sc, &mut obj, (z0, s.h), tol)?;
         }
         self.work.history.clear();
-        let (mut iterations, plateaus) =
-            self.solve_sqp(&mut obj, z0, (s.h, &s.bounds), tol, skip)?;
+        let (mut iterations, plateaus) = self.solve_sqp(
+            &mut obj,
+            z0,
+            (s.h, &s.bounds),
+            tol,
+            (skip, s.warm.is_none() && !declared),
+        )?;
         if s.warm.is_none() {
             let (h, mu) = (s.h, s.mu);
             let at = (tol, s.h_safe, iterations);

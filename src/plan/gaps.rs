@@ -166,7 +166,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 break;
             }
             let every = u64::MAX;
-            let (total, _) = self.solve_sqp(obj, &z, (h, bounds), tol, every)?;
+            let (total, _) = self.solve_sqp(obj, &z, (h, bounds), tol, (every, false))?;
             iterations = total;
         }
         self.horizon_len = h;

@@ -112,7 +112,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// scanned over its box, the others held, and the SQP restarted from
     /// a feasible point of lower `J` (kept if it ends lower). A coordinate
     /// in `skip` (bit `j`) was scanned by the previous call, whose plan
-    /// this one continues, and is not scanned again. `tol` is the
+    /// this one continues, and is not scanned again. `far`: a cold call's
+    /// run, whose kink escape may move further (`kink.rs`). `tol` is the
     /// feasibility tolerance (m). Returns the iterations and the
     /// coordinates scanned (bits).
     pub(super) fn solve_sqp(
@@ -121,7 +122,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         z0: &[f32; K],
         (h, bounds): (usize, &Bounds<K>),
         tol: f32,
-        skip: u64,
+        (skip, far): (u64, bool),
     ) -> Result<(u32, u64), PlanError> {
         // (A run after the call's first continues its history: its start
         // counts as one more iteration, as a plateau's restart does.)
@@ -131,7 +132,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         } else {
             0
         };
-        let out = self.solve_sqp_run(obj, z0, (h, bounds), tol, skip)?;
+        let out = self.solve_sqp_run(obj, z0, (h, bounds), tol, (skip, far))?;
         self.work.iterations = before.saturating_add(out.0);
         Ok((self.work.iterations, out.1))
     }
@@ -143,7 +144,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         z0: &[f32; K],
         (h, bounds): (usize, &Bounds<K>),
         tol: f32,
-        skip: u64,
+        (skip, far): (u64, bool),
     ) -> Result<(u32, u64), PlanError> {
         let mut metric = None;
         let run = sqp_into(
@@ -211,7 +212,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if let Some(g) = end.kink
             && iterations < self.cfg.bfgs.max_iterations
         {
-            iterations = self.leave_kink(obj, (h, bounds), (g, tol), iterations);
+            iterations = self.leave_kink(obj, (h, bounds), (g, tol, far), iterations);
         }
         self.work.iterations = iterations;
         Ok((iterations, scanned | skip))
