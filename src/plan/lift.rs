@@ -22,9 +22,12 @@
 //! track `g − 1` can buy a deep track `g` (`unseen_90317_0`, where the
 //! best plan climbs 209 m on track 3 to fly track 4 250 m deeper). The
 //! least such lift found by doubling is narrowed by [`NARROW`] bisections
-//! (one flight each). Either start is flown whole (one flight of the
-//! tail) and the SQP restarted from it where the horizon's `J` is lower,
-//! kept only if it ends better.
+//! (one flight each); where the climb saturates before any lift frees it,
+//! the least lift that reached the saturation is taken. Either start is
+//! flown whole (one flight of the tail) and the SQP restarted from it
+//! where the horizon's `J` is lower (and a freed start's infeasibility
+//! within the band), kept only if it ends better; then the next later
+//! track, from wherever the workspace stands.
 
 use crate::optim::Bounds;
 use crate::sim::{Scenario, VehicleState};
@@ -109,13 +112,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 .map(|p| p.min(hi))
                 .filter(|&p| p > zg + band),
         };
-        let start = match l.search(obj, z)? {
-            Next::Freed(start) => start,
-            Next::Deep(lifts) => l.narrowed(obj, z, lifts)?,
+        // (A freed start is kept within the band of feasible, as the SQP
+        // left it; a start at the preferred depth may be far from it, the
+        // climb saturated, and the restart's first steps close that.)
+        let (start, most) = match l.search(obj, z)? {
+            Next::Freed(start) => (start, band),
+            Next::Deep(lifts) => (l.narrowed(obj, z, lifts)?, f32::INFINITY),
             Next::Nothing => return Ok(None),
         };
-        let (jz, _) = obj.tail_value(&head, (&at_j, j), &start)?;
-        Ok((jz < self.work.j).then_some(start))
+        let (jz, v) = obj.tail_value(&head, (&at_j, j), &start)?;
+        Ok((v <= most && jz < self.work.j).then_some(start))
     }
 }
 
