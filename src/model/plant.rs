@@ -444,7 +444,7 @@ impl<const N: usize> Plant<N> {
     /// [`Plant::step`] on the simulation's vector type.
     #[inline(always)]
     pub(crate) fn step_v(&self, eta: &SVector<f32, N>, elevator: f32) -> SVector<f32, N> {
-        self.ad * eta + self.bd * elevator
+        &self.ad * eta + self.bd.scale(elevator)
     }
 }
 
