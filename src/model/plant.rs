@@ -443,6 +443,9 @@ impl<const N: usize> Plant<N> {
 
     /// [`Plant::step`] on the simulation's vector type.
     #[inline(always)]
+    // (`&self.ad`: by value, nalgebra copies `Ad` each step, a `memcpy`
+    // call where the caller's inlining does not remove it.)
+    #[allow(clippy::op_ref)]
     pub(crate) fn step_v(&self, eta: &SVector<f32, N>, elevator: f32) -> SVector<f32, N> {
         &self.ad * eta + self.bd.scale(elevator)
     }

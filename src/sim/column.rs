@@ -219,7 +219,10 @@ impl<const N: usize> Column<N> {
         let w = f.elevator * (kp_t * e_t + ki_t * self.pitch_integral - kd_t * pitch_rate);
         self.depth_integral += f.depth_integral * e_d;
         self.pitch_integral += f.pitch_integral * e_t;
-        self.eta = &g.ad * self.eta + g.bd.scale(w);
+        // (By reference: by value, nalgebra copies `Ad` each step.)
+        #[allow(clippy::op_ref)]
+        let eta = &g.ad * self.eta + g.bd.scale(w);
+        self.eta = eta;
         let mean = pitch + self.eta.get(0).copied().unwrap_or(0.0);
         self.d_prev = self.d;
         self.x_prev = self.x;
