@@ -1172,6 +1172,28 @@ fn a_cold_kink_escape_moves_as_far_as_the_dive_needs() {
     );
 }
 
+/// A narrow feasible window at a plateau's edge: on a random canyon line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 5151`,
+/// `unseen_5151_1`) track 1's saturated climb is flat in `z_1` up to about
+/// 130 m; deeper, the line's `J` falls until a cliff near 200 m where
+/// track 1's least altitude drops from 61 m to 27 m. The plateau scan's 9
+/// points (97 m apart) read 126.9 m flat and 223.5 m infeasible, and the
+/// cold call committed 30.2 m: line `J` 1.4135e7 m³, 1.074× the f64 beam
+/// search's best safe plan (1.316275e7 m³, track 1 at 180.8 m). With the
+/// scan's step into the cliff bisected (`jump.rs`), 0.995×. Bound 1.02×:
+/// the checker's 1.10× passed this line before.
+#[test]
+fn a_plateau_scan_finds_the_window_before_a_cliff() {
+    let (p, w, _) = fixture("plateau_edge");
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(
+        total <= 1.02 * 1.316275e7,
+        "J {total} vs the best safe 1.316275e7"
+    );
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200

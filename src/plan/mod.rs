@@ -141,6 +141,7 @@ mod config;
 mod fallback;
 mod flights;
 mod gaps;
+mod jump;
 mod kink;
 mod lift;
 mod objective;

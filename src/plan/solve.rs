@@ -13,7 +13,7 @@ use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
 use crate::sim::{SimError, TrackScore};
 
 use super::objective::{PlanObjective, Stop};
-use super::scan::{grid, reach_from};
+use super::scan::grid;
 use super::{Method, PlanError, Planner, PlannerConfig};
 
 /// Rounds of the SQP's plateau escape: each scans every plateau, then
@@ -27,7 +27,7 @@ const PLATEAU_ROUNDS: u32 = 2;
 /// a half of `ρ v` where it paid). A point whose `J` gain does not cover
 /// it brings the SQP back to the optimum it left, or to one as good, at
 /// the cost of a second solve (measured: 5 to 14 iterations).
-const RESTORE_SHARE: f32 = 0.1;
+pub(super) const RESTORE_SHARE: f32 = 0.1;
 
 /// Factor on `μ` between penalty stages.
 const PENALTY_GROWTH: f32 = 100.0;
@@ -267,71 +267,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         obj.last_violation = kept_v;
         acc.restore(&kept);
         None
-    }
-
-    /// The best point of a scan of coordinate `j` when `∂J/∂z_j` is
-    /// exactly zero (the pitch reference saturated over the whole track:
-    /// no gradient, of `J` or of the altitudes after it, can move it), the
-    /// others held. From an infeasible optimum (shortfall `v` above `tol`,
-    /// m), the point of least `v` if it is less; from a feasible one, the
-    /// lowest `J` among the points whose `v` is within the mission's band
-    /// `h_r − h_a` (m), if it beats the optimum's by more than the
-    /// stopping threshold once its shortfall is priced at
-    /// [`RESTORE_SHARE`] of the finished run's merit weight `ρ` (m³/m).
-    /// The SQP restarted from it moves the other
-    /// depths too (and is kept only if it ends better): a plateau left by
-    /// one depth alone may need its neighbours to follow. Not inlined: the
-    /// scan's state stays off the stack of the SQP runs.
-    #[inline(never)]
-    fn sqp_plateau_jump(
-        &self,
-        obj: &mut PlanObjective<'_, N>,
-        bounds: &Bounds<K>,
-        j: usize,
-        (tol, rho): (f32, f32),
-    ) -> Option<((f32, f32), [f32; K])> {
-        let (&lo, &hi) = bounds.lo.get(j).zip(bounds.hi.get(j))?;
-        let out = &self.work;
-        if lo >= hi || out.gradient.get(j).is_none_or(|&g| g != 0.0) {
-            return None;
-        }
-        let m = obj.sc.mission();
-        let band = m.reference_altitude() - m.min_altitude();
-        let v_now = obj.last_violation;
-        let restoring = v_now > tol;
-        let threshold = out.j - self.cfg.bfgs.tol.j_threshold(out.j);
-        // The tracks before `j` fly the same whatever `z_j`: once.
-        let (head, at_j) = obj.head(&out.z, j).ok()?;
-        // Within the reach from where track `j` starts (beyond, the same
-        // plateau).
-        let t = obj.track.saturating_add(j);
-        let (lo, hi) = reach_from(&obj.sc, t, at_j.depth(), (lo, hi));
-        let mut best: Option<((f32, f32), [f32; K])> = None;
-        for k in 0..self.cfg.scan_points {
-            let mut z = out.z;
-            if let Some(zj) = z.get_mut(j) {
-                *zj = grid(lo, hi, k, self.cfg.scan_points);
-            }
-            let Ok((jz, v)) = obj.tail_value(&head, (&at_j, j), &z) else {
-                continue;
-            };
-            // Restoring: the feasible points first, by `J` (the least
-            // shortfall alone would take the worst of several feasible
-            // depths), then the rest by shortfall.
-            let (score, bar) = if restoring {
-                let feasible = v <= tol;
-                let key = if feasible { (0.0, jz) } else { (v, 0.0) };
-                (key, (v_now - tol, 0.0))
-            } else if v <= band && jz + RESTORE_SHARE * rho * v < threshold {
-                ((0.0, jz), (0.0, threshold))
-            } else {
-                continue;
-            };
-            if lex_less(score, best.as_ref().map_or(bar, |b| b.0)) {
-                best = Some((score, z));
-            }
-        }
-        best
     }
 
     /// Further penalty stages: each re-solves from the last optimum with
@@ -581,7 +516,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 }
 
 /// `a < b` in the order of their first entries, then their second.
-fn lex_less(a: (f32, f32), b: (f32, f32)) -> bool {
+pub(super) fn lex_less(a: (f32, f32), b: (f32, f32)) -> bool {
     match a.0.partial_cmp(&b.0) {
         Some(core::cmp::Ordering::Less) => true,
         Some(core::cmp::Ordering::Equal) => a.1 < b.1,

@@ -1,0 +1,164 @@
+//! The SQP's plateau escape, one coordinate: a depth whose `∂J/∂z_j` is
+//! exactly zero (the pitch reference saturated over the whole track) is
+//! scanned over its reach, the others held, for a point to restart the
+//! SQP from (`solve.rs` restarts from the best over the plateaus).
+//!
+//! A plateau's edge can hide a narrow feasible window: on a random canyon
+//! line (`check_planner.py --seed 5151`, `unseen_5151_1`) track 1's
+//! saturated climb is flat for `z_1` up to about 130 m, then its `J` and
+//! track 2's fall until a cliff near 200 m where track 1's least
+//! altitude drops from 61 m to 27 m. The 9-point scan (every 97 m) read
+//! 126.9 m flat and 223.5 m infeasible, and the call committed 30.2 m:
+//! the line's `J` 1.074× the best safe plan's (180.8 m). Where the scan
+//! passes from a point within the band to one beyond it whose `J` is
+//! lower, the pair is bisected [`EDGE`] times (one flight of the tail
+//! each) for the feasible point nearest the cliff.
+
+use crate::optim::Bounds;
+use crate::sim::{TrackScore, VehicleState};
+
+use super::Planner;
+use super::objective::PlanObjective;
+use super::scan::{grid, reach_from};
+use super::solve::{RESTORE_SHARE, lex_less};
+
+/// Bisections of a scan's step from a point within the band to one
+/// beyond it with a lower `J`.
+const EDGE: u32 = 3;
+
+/// A scanned point: `(z_j, Σ J, v)`, m, m³, m.
+type Point = (f32, f32, f32);
+
+/// A restart candidate: its score (shortfall, `J`) and its depths.
+type Jump<const K: usize> = ((f32, f32), [f32; K]);
+
+impl<const K: usize, const N: usize> Planner<K, N> {
+    /// The best point of a scan of coordinate `j` when `∂J/∂z_j` is
+    /// exactly zero (no gradient, of `J` or of the altitudes after it, can
+    /// move it), the others held. From an infeasible optimum (shortfall
+    /// `v` above `tol`, m), the point of least `v` if it is less; from a
+    /// feasible one, the lowest `J` among the points whose `v` is within
+    /// the mission's band `h_r − h_a` (m), if it beats the optimum's by
+    /// more than the stopping threshold once its shortfall is priced at
+    /// [`RESTORE_SHARE`] of the finished run's merit weight `ρ` (m³/m),
+    /// the scan's edges bisected as in the module docs. The SQP restarted
+    /// from it moves the other depths too (and is kept only if it ends
+    /// better): a plateau left by one depth alone may need its neighbours
+    /// to follow. Not inlined: the scan's state stays off the stack of
+    /// the SQP runs.
+    #[inline(never)]
+    pub(super) fn sqp_plateau_jump(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        bounds: &Bounds<K>,
+        j: usize,
+        (tol, rho): (f32, f32),
+    ) -> Option<Jump<K>> {
+        let (&lo, &hi) = bounds.lo.get(j).zip(bounds.hi.get(j))?;
+        let out = &self.work;
+        if lo >= hi || out.gradient.get(j).is_none_or(|&g| g != 0.0) {
+            return None;
+        }
+        let m = obj.sc.mission();
+        let band = m.reference_altitude() - m.min_altitude();
+        let v_now = obj.last_violation;
+        let restoring = v_now > tol;
+        let threshold = out.j - self.cfg.bfgs.tol.j_threshold(out.j);
+        // The tracks before `j` fly the same whatever `z_j`: once.
+        let (head, at_j) = obj.head(&out.z, j).ok()?;
+        // Within the reach from where track `j` starts (beyond, the same
+        // plateau).
+        let t = obj.track.saturating_add(j);
+        let (lo, hi) = reach_from(&obj.sc, t, at_j.depth(), (lo, hi));
+        // Scores a point: restoring, the feasible points first, by `J`
+        // (the least shortfall alone would take the worst of several
+        // feasible depths), then the rest by shortfall.
+        let score = |(_, jz, v): Point| -> Option<((f32, f32), (f32, f32))> {
+            if restoring {
+                let key = if v <= tol { (0.0, jz) } else { (v, 0.0) };
+                Some((key, (v_now - tol, 0.0)))
+            } else if v <= band && jz + RESTORE_SHARE * rho * v < threshold {
+                Some(((0.0, jz), (0.0, threshold)))
+            } else {
+                None
+            }
+        };
+        let mut best: Option<Jump<K>> = None;
+        let mut keep = |p: Point, z: [f32; K]| {
+            if let Some((s, bar)) = score(p)
+                && lex_less(s, best.as_ref().map_or(bar, |b| b.0))
+            {
+                best = Some((s, z));
+            }
+        };
+        let flown = (&head, &at_j, j);
+        let mut prev: Option<Point> = None;
+        // The scan's step into a lower `J` beyond the band (from within
+        // it) whose far side is lowest: (within, beyond).
+        let mut edge: Option<(Point, Point)> = None;
+        for k in 0..self.cfg.scan_points {
+            let Some(p) = at_depth(obj, flown, grid(lo, hi, k, self.cfg.scan_points), &out.z)
+            else {
+                continue;
+            };
+            keep(p, with(&out.z, j, p.0));
+            if let Some(q) = prev.filter(|_| !restoring) {
+                edge = lower_edge(edge, (q, p), band);
+            }
+            prev = Some(p);
+        }
+        if let Some((mut inside, mut beyond)) = edge {
+            for _ in 0..EDGE {
+                let Some(p) = at_depth(obj, flown, 0.5 * (inside.0 + beyond.0), &out.z) else {
+                    break;
+                };
+                keep(p, with(&out.z, j, p.0));
+                if p.2 <= band {
+                    inside = p;
+                } else {
+                    beyond = p;
+                }
+            }
+        }
+        best
+    }
+}
+
+/// `z` with `z_j` at `zj` (m).
+fn with<const K: usize>(z: &[f32; K], j: usize, zj: f32) -> [f32; K] {
+    let mut out = *z;
+    if let Some(v) = out.get_mut(j) {
+        *v = zj;
+    }
+    out
+}
+
+/// The point `z_j = zj` (m) of `z`, whose tracks before `j` flew `head`
+/// and left `at_j`: one flight of the tail; `None` if it failed.
+fn at_depth<const K: usize, const N: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    (head, at_j, j): (&[TrackScore; K], &VehicleState<N>, usize),
+    zj: f32,
+    z: &[f32; K],
+) -> Option<Point> {
+    let (jz, v) = obj.tail_value(head, (at_j, j), &with(z, j, zj)).ok()?;
+    Some((zj, jz, v))
+}
+
+/// `edge`, or the step `(a, b)` between neighbouring scanned points if one
+/// is within `band` (m of shortfall) and the other beyond it with a lower
+/// `J`, lower than `edge`'s far side.
+fn lower_edge(
+    edge: Option<(Point, Point)>,
+    (a, b): (Point, Point),
+    band: f32,
+) -> Option<(Point, Point)> {
+    let step = match (a.2 <= band, b.2 <= band) {
+        (true, false) => (a, b),
+        (false, true) => (b, a),
+        _ => return edge,
+    };
+    let (inside, beyond) = step;
+    let lower = beyond.1 < inside.1 && edge.is_none_or(|(_, e)| beyond.1 < e.1);
+    if lower { Some(step) } else { edge }
+}
