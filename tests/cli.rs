@@ -1194,6 +1194,50 @@ fn a_plateau_scan_finds_the_window_before_a_cliff() {
     );
 }
 
+/// Track 1's `J` of a track-wise constrained plan of `name`.
+fn track_one_j(name: &str) -> f64 {
+    let (p, w, _) = fixture(name);
+    let v = json_of(&[
+        "--profile",
+        &p,
+        "--waypoints",
+        &w,
+        "--mode",
+        "track",
+        "--json",
+    ]);
+    assert_eq!(v["tracks"][0]["safe"], true);
+    v["tracks"][0]["J"].as_f64().unwrap()
+}
+
+/// A boundary where the least altitude hardly moves with the depth: on a
+/// random line (`tools/reference/check_planner.py --unseen 8 --seed 8080`,
+/// `unseen_8080_6`, track-wise, constrained) track 1's least altitude
+/// falls 0.024 m per m of depth at its boundary while `J` falls 0.46 % per
+/// m. The boundary search stopped on its altitude tolerance 3.3 mm above
+/// `h_a`, 0.13 m short in depth: `J` 51 822.6 m³, 1.0062× the f64 search's
+/// best safe 51 503.8 m³ (622.770 m), over the checker's 1.005×. Near in
+/// depth as well (`optim/root.rs`): 1.0041×.
+#[test]
+fn a_flat_boundary_is_found_near_in_depth_too() {
+    let j = track_one_j("track_flat_boundary");
+    assert!(j <= 1.005 * 51503.8, "J {j} vs the best safe 51503.8");
+}
+
+/// An interior optimum within `CHECK_STEP` of the boundary: on a random
+/// line (`check_planner.py --unseen 8 --seed 1234`, `unseen_1234_2`,
+/// track-wise, constrained) `J` is least at 1 089.24 m (least altitude
+/// 60.89 m), 0.88 m inside the boundary. The optimizer overshot; the check
+/// 2 m into the safe set read `J` higher than at the boundary, so the
+/// boundary was kept: 34 349.2 m³, 1.0054× the f64 search's best safe
+/// 34 164.4 m³. A second look a quarter of the step in (`candidate.rs`,
+/// `single.rs`) finds `J` falling and the optimizer runs: 1.0000×.
+#[test]
+fn an_optimum_just_inside_the_boundary_is_not_lost_to_it() {
+    let j = track_one_j("track_near_interior");
+    assert!(j <= 1.005 * 34164.4, "J {j} vs the best safe 34164.4");
+}
+
 /// A horizon with no safe plan whose SQP stalls infeasible: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 43`,
 /// `unseen_43_6`) calls 2 and 3 took Armijo's 2⁻¹⁰ steps for all 200

@@ -353,7 +353,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// After a trip, when the optimizer only overshot: where `J` falls
     /// from the boundary `f` into the safe set (away from the trip at
-    /// `z_bad`, a finite difference of `CHECK_STEP`), the optimum is
+    /// `z_bad`, a finite difference of `CHECK_STEP` or, if not, of a
+    /// quarter of it), the optimum is
     /// interior and the guarded optimizer runs once more from the boundary
     /// (its steps only lower `J`); its candidate unless it trips again.
     /// Unbudgeted calls only (the budgeted ones keep the boundary).
@@ -367,10 +368,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if self.budget.limit != u32::MAX || f.score.min_altitude() < s.h_safe {
             return Ok(None);
         }
-        let Ok((score, _)) = fl.fly(z_b + single::CHECK_STEP.copysign(z_b - z_bad)) else {
-            return Ok(None);
+        // (A step of `CHECK_STEP`, then a quarter of it: an interior
+        // optimum within the step leaves `J` higher at its far end.)
+        let mut falls = |step: f32| {
+            fl.fly(z_b + step.copysign(z_b - z_bad))
+                .is_ok_and(|(score, _)| score.j() < f.score.j() && score.min_altitude() >= s.h_safe)
         };
-        if score.j() >= f.score.j() || score.min_altitude() < s.h_safe {
+        if !(falls(single::CHECK_STEP) || falls(0.25 * single::CHECK_STEP)) {
             return Ok(None);
         }
         // (The first run's flights are in `fl.count` already; unbudgeted,

@@ -76,7 +76,13 @@ pub(super) fn decide<const N: usize>(
                 }
             };
             let slope = (j_in - b.at.score.j()) / (z_in - z_b);
-            if slope * inward < 0.0 {
+            // (Where `J` rises over that step, the optimum may still lie
+            // within it: a second look at a quarter of it, one flight.)
+            let mut short = || {
+                let z = z_b + 0.25 * step;
+                fl.fly(z).is_ok_and(|(s, _)| s.j() < b.at.score.j())
+            };
+            if slope * inward < 0.0 || (libm::fabsf(z_in - z_b) > 0.5 * CHECK_STEP && short()) {
                 // An interior optimum: optimize from the boundary.
                 Ok(Decision::Optimize {
                     z0: z_b,
