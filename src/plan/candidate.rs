@@ -368,13 +368,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if self.budget.limit != u32::MAX || f.score.min_altitude() < s.h_safe {
             return Ok(None);
         }
-        // (A step of `CHECK_STEP`, then a quarter of it: an interior
-        // optimum within the step leaves `J` higher at its far end.)
         let mut falls = |step: f32| {
             fl.fly(z_b + step.copysign(z_b - z_bad))
                 .is_ok_and(|(score, _)| score.j() < f.score.j() && score.min_altitude() >= s.h_safe)
         };
-        if !(falls(single::CHECK_STEP) || falls(0.25 * single::CHECK_STEP)) {
+        if !(falls(single::CHECK_STEP) || falls(single::CHECK_SHORT * single::CHECK_STEP)) {
             return Ok(None);
         }
         // (The first run's flights are in `fl.count` already; unbudgeted,

@@ -19,7 +19,7 @@ use crate::sim::{TrackScore, VehicleState};
 
 use super::Planner;
 use super::objective::PlanObjective;
-use super::scan::{grid, reach_from};
+use super::scan::{grid, reach_from, with_depth};
 use super::solve::{RESTORE_SHARE, lex_less};
 
 /// Bisections of a scan's step from a point within the band to one
@@ -101,7 +101,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             else {
                 continue;
             };
-            keep(p, with(&out.z, j, p.0));
+            keep(p, with_depth(&out.z, j, p.0));
             if let Some(q) = prev.filter(|_| !restoring) {
                 edge = lower_edge(edge, (q, p), band);
             }
@@ -112,7 +112,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 let Some(p) = at_depth(obj, flown, 0.5 * (inside.0 + beyond.0), &out.z) else {
                     break;
                 };
-                keep(p, with(&out.z, j, p.0));
+                keep(p, with_depth(&out.z, j, p.0));
                 if p.2 <= band {
                     inside = p;
                 } else {
@@ -124,15 +124,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 }
 
-/// `z` with `z_j` at `zj` (m).
-fn with<const K: usize>(z: &[f32; K], j: usize, zj: f32) -> [f32; K] {
-    let mut out = *z;
-    if let Some(v) = out.get_mut(j) {
-        *v = zj;
-    }
-    out
-}
-
 /// The point `z_j = zj` (m) of `z`, whose tracks before `j` flew `head`
 /// and left `at_j`: one flight of the tail; `None` if it failed.
 fn at_depth<const K: usize, const N: usize>(
@@ -141,7 +132,9 @@ fn at_depth<const K: usize, const N: usize>(
     zj: f32,
     z: &[f32; K],
 ) -> Option<Point> {
-    let (jz, v) = obj.tail_value(head, (at_j, j), &with(z, j, zj)).ok()?;
+    let (jz, v) = obj
+        .tail_value(head, (at_j, j), &with_depth(z, j, zj))
+        .ok()?;
     Some((zj, jz, v))
 }
 

@@ -34,6 +34,7 @@ use crate::sim::{Scenario, VehicleState};
 
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
+use super::scan::with_depth;
 
 /// Lifts tried for one track (the band, doubling).
 const LIFTS: u32 = 6;
@@ -171,15 +172,15 @@ impl<const N: usize> Lift<N> {
         let mut last = f32::NEG_INFINITY;
         for _ in 0..LIFTS {
             let up = crate::num::max(self.zj - lift, self.lo);
-            set(&mut z, j, up);
-            set(&mut z, g, self.zg);
+            z = with_depth(&z, j, up);
+            z = with_depth(&z, g, self.zg);
             let freed = obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band;
             if freed >= 0.0 {
-                set(&mut z, g, self.zg + freed);
+                z = with_depth(&z, g, self.zg + freed);
                 return Ok(Next::Freed(z));
             }
             if let Some(p) = self.deep {
-                set(&mut z, g, p);
+                z = with_depth(&z, g, p);
                 let a = obj.least_at((&self.at_j, j), &z, g)?;
                 if a >= self.target {
                     return Ok(Next::Deep((held, self.zj - up)));
@@ -209,11 +210,11 @@ impl<const N: usize> Lift<N> {
         (mut held, mut free): (f32, f32),
     ) -> Result<[f32; K], Stop> {
         let p = self.deep.unwrap_or(self.zg);
-        set(&mut z, self.g, p);
+        z = with_depth(&z, self.g, p);
         if free > held {
             for _ in 0..NARROW {
                 let mid = 0.5 * (held + free);
-                set(&mut z, self.j, self.zj - mid);
+                z = with_depth(&z, self.j, self.zj - mid);
                 if obj.least_at((&self.at_j, self.j), &z, self.g)? >= self.target {
                     free = mid;
                 } else {
@@ -221,15 +222,8 @@ impl<const N: usize> Lift<N> {
                 }
             }
         }
-        set(&mut z, self.j, self.zj - free);
+        z = with_depth(&z, self.j, self.zj - free);
         Ok(z)
-    }
-}
-
-/// Sets `z[i]` where it exists.
-fn set<const K: usize>(z: &mut [f32; K], i: usize, v: f32) {
-    if let Some(x) = z.get_mut(i) {
-        *x = v;
     }
 }
 

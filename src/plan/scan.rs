@@ -23,6 +23,15 @@ pub(super) fn grid(lo: f32, hi: f32, k: u32, n: u32) -> f32 {
     }
 }
 
+/// The horizon `z` with depth `j` at `zj` (m); `z` itself past its end.
+pub(super) fn with_depth<const K: usize>(z: &[f32; K], j: usize, zj: f32) -> [f32; K] {
+    let mut out = *z;
+    if let Some(v) = out.get_mut(j) {
+        *v = zj;
+    }
+    out
+}
+
 /// What the reach of a track's depth is made of: `sin` of the steepest
 /// flight path (a little over the pitch limit) and the depth error that
 /// saturates the pitch reference plus 20 m (m).

@@ -20,6 +20,10 @@ use super::status::{Found, OptimizerStop};
 /// not decrease into the safe set).
 pub(super) const CHECK_STEP: f32 = 2.0;
 
+/// Where `J` rises over the check's step, the second look's share of it:
+/// an interior optimum within the first step leaves `J` higher at its end.
+pub(super) const CHECK_SHORT: f32 = 0.25;
+
 /// One end of a boundary bracket: a depth (m) and its minimum altitude
 /// (m) when known.
 type End = (f32, Option<f32>);
@@ -77,9 +81,9 @@ pub(super) fn decide<const N: usize>(
             };
             let slope = (j_in - b.at.score.j()) / (z_in - z_b);
             // (Where `J` rises over that step, the optimum may still lie
-            // within it: a second look at a quarter of it, one flight.)
+            // within it: a second look, one flight.)
             let mut short = || {
-                let z = z_b + 0.25 * step;
+                let z = z_b + CHECK_SHORT * step;
                 fl.fly(z).is_ok_and(|(s, _)| s.j() < b.at.score.j())
             };
             if slope * inward < 0.0 || (libm::fabsf(z_in - z_b) > 0.5 * CHECK_STEP && short()) {
