@@ -1046,6 +1046,17 @@ fn a_warm_last_track_stays_by_its_boundary() {
     );
 }
 
+/// The horizon plan of fixture `name` (default vehicle) is safe and its
+/// line `J` within `ratio` of `best` (m³), the f64 beam search's best safe
+/// plan.
+fn horizon_within(name: &str, ratio: f64, best: f64) {
+    let (p, w, _) = fixture(name);
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(total <= ratio * best, "J {total} vs the best safe {best}");
+}
+
 /// The horizon's plateau escape rescans, in its second round, what its
 /// first round scanned but did not jump: on a random canyon line
 /// (`tools/reference/check_planner.py --unseen 8 --seed 13`, `unseen_13_7`)
@@ -1056,14 +1067,7 @@ fn a_warm_last_track_stays_by_its_boundary() {
 /// checker's bound is 1.10×.
 #[test]
 fn a_plateau_left_after_another_jump() {
-    let (p, w, _) = fixture("plateau_second");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.10 * 3.3596e6,
-        "J {total} vs the best safe 3.3596e6"
-    );
+    horizon_within("plateau_second", 1.10, 3.3596e6);
 }
 
 /// The SQP ends no worse than the best feasible point it passed: on a
@@ -1078,14 +1082,7 @@ fn a_plateau_left_after_another_jump() {
 /// checker's bound is 1.10×.
 #[test]
 fn the_sqp_ends_no_worse_than_its_best_feasible_point() {
-    let (p, w, _) = fixture("best_feasible");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.10 * 8.27996e7,
-        "J {total} vs the best safe 8.27996e7"
-    );
+    horizon_within("best_feasible", 1.10, 8.27996e7);
 }
 
 /// A later track held at its target by the depth before it: on a random
@@ -1098,14 +1095,7 @@ fn the_sqp_ends_no_worse_than_its_best_feasible_point() {
 /// With `lift.rs`, 1.001×. The checker's bound is 1.10×.
 #[test]
 fn a_later_track_dives_once_the_one_before_is_lifted() {
-    let (p, w, _) = fixture("lift_earlier");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.10 * 1.534436e7,
-        "J {total} vs the best safe 1.534436e7"
-    );
+    horizon_within("lift_earlier", 1.10, 1.534436e7);
 }
 
 /// A climb bought for a dive: on a random canyon line
@@ -1120,14 +1110,7 @@ fn a_later_track_dives_once_the_one_before_is_lifted() {
 /// checker's bound is 1.10×.
 #[test]
 fn a_track_climbs_so_that_the_next_can_dive_past_a_rise() {
-    let (p, w, _) = fixture("lift_to_dive");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.10 * 3.282938e6,
-        "J {total} vs the best safe 3.282938e6"
-    );
+    horizon_within("lift_to_dive", 1.10, 3.282938e6);
 }
 
 /// A metric no longer definite in f32: on a random canyon line
@@ -1141,14 +1124,7 @@ fn a_track_climbs_so_that_the_next_can_dive_past_a_rise() {
 /// (`unseen_5151_3`: 1.15× → 0.9997×). The checker's bound is 1.10×.
 #[test]
 fn an_indefinite_metric_is_reset_not_the_end_of_the_run() {
-    let (p, w, _) = fixture("indefinite_metric");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.10 * 1.626596e7,
-        "J {total} vs the best safe 1.626596e7"
-    );
+    horizon_within("indefinite_metric", 1.10, 1.626596e7);
 }
 
 /// A kink far from its way out: on a random line
@@ -1162,14 +1138,7 @@ fn an_indefinite_metric_is_reset_not_the_end_of_the_run() {
 /// finds 1.001×. The checker's bound is 1.10×.
 #[test]
 fn a_cold_kink_escape_moves_as_far_as_the_dive_needs() {
-    let (p, w, _) = fixture("kink_far");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.10 * 1.99653e6,
-        "J {total} vs the best safe 1.99653e6"
-    );
+    horizon_within("kink_far", 1.10, 1.99653e6);
 }
 
 /// A narrow feasible window at a plateau's edge: on a random canyon line
@@ -1184,14 +1153,7 @@ fn a_cold_kink_escape_moves_as_far_as_the_dive_needs() {
 /// the checker's 1.10× passed this line before.
 #[test]
 fn a_plateau_scan_finds_the_window_before_a_cliff() {
-    let (p, w, _) = fixture("plateau_edge");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(
-        total <= 1.02 * 1.316275e7,
-        "J {total} vs the best safe 1.316275e7"
-    );
+    horizon_within("plateau_edge", 1.02, 1.316275e7);
 }
 
 /// Track 1's `J` of a track-wise constrained plan of `name`.
