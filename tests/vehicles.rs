@@ -63,3 +63,38 @@ fn a_low_authority_vehicle_starts_again_wider() {
     assert_eq!(v["safe"], true);
     assert!(total <= 1.10 * 4.169_39e7, "J {total} vs the best safe");
 }
+
+/// `plan --json` (the horizon) on fixture `name` with its vehicle: safe,
+/// and the line's `J` within `ratio` of the f64 beam search's `best`.
+fn horizon_within(name: &str, ratio: f64, best: f64) {
+    let (p, w, c) = fixture(name);
+    let v = json_of(&["--profile", &p, "--waypoints", &w, "--config", &c, "--json"]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(total <= ratio * best, "J {total} vs the best safe {best}");
+}
+
+/// A row beyond the QP's band, crossed unseen (`check_planner.py --seed
+/// 1103 --vehicle tools/reference/vehicles/integ.toml`, `unseen_1103_3`):
+/// track 1's least altitude stays 78.9 m for every depth up to 346 m and
+/// then falls 1.4 m a metre, so its rows in the band had no gradient and
+/// the one that had lay beyond the band. The cold SQP stepped track 1
+/// from 306 to 626 m, 70 m short, under a merit weight of 0, stalled, and
+/// went back to its start: the line's `J` 1.0720e8 m³, 1.49× the best
+/// safe 7.193117e7 (track 1 at 360.9 m). The careful restart from there
+/// (`optim/sqp.rs`): 1.0000×. The checker's bound is 1.10×.
+#[test]
+fn a_row_beyond_the_band_is_not_crossed_unseen() {
+    horizon_within("careful_integ", 1.01, 7.193_117e7);
+}
+
+/// The same on another vehicle (`--seed 1104 --vehicle
+/// tools/reference/vehicles/second.toml`, `unseen_1104_6`: 2.5 m/s, a
+/// second-order plant): a row 26.4 m clear, falling 0.96 m a metre, beyond
+/// the 20 m band; the step of 190 m crossed it and the run went back to
+/// its start. `J` 4.2673e7 m³, 1.32× the best safe 3.229877e7; careful,
+/// 1.0003×.
+#[test]
+fn a_crossed_row_on_a_second_order_vehicle() {
+    horizon_within("careful_second", 1.01, 3.229_877e7);
+}

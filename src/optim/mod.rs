@@ -20,6 +20,7 @@ pub mod gd;
 pub(crate) mod qp;
 pub(crate) mod root;
 pub(crate) mod sqp;
+pub(crate) mod step;
 
 use core::fmt;
 

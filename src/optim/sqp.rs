@@ -30,6 +30,18 @@
 //! constraint is asked for `1 − σ` of its shortfall, `σ` = ½, 0.9, then 1
 //! (do not make it worse), which `d = 0` always satisfies.
 //!
+//! The QP takes only the rows within the objective's band
+//! ([`Linearized::band`]). A careful run (the planner's restart from the
+//! best feasible iterate of a run that had to go back there) also takes
+//! the rows beyond it that the step would cross by their linearization,
+//! and solves again: a row 26 m clear but falling 0.96 m a metre is
+//! crossed by a 190 m step. On a random line with an integrating depth
+//! loop (`check_planner.py --seed 1103 --vehicle
+//! tools/reference/vehicles/integ.toml`, `unseen_1103_3`) the first run
+//! stepped 320 m past such a row into a 70 m shortfall that the merit's
+//! weight, still 0, did not count, stalled there and went back to its
+//! start: the line's `J` was 1.49× the best safe; careful, 1.0000×.
+//!
 //! Stops (each with `v` within the feasibility tolerance): the step
 //! shorter than [`STEP_TOL`] (m), or the QP's model of the decrease of
 //! `J` below the relative tolerance of [`super::Tolerances`] (as BFGS's
@@ -46,9 +58,11 @@
 use heapless::Vec;
 
 use super::best::BestFeasible;
-pub(crate) use super::constrained::{CONSTRAINTS, Constrained, Linearized};
+use super::constrained::CONSTRAINTS;
+pub(crate) use super::constrained::{Constrained, Linearized};
 use super::dense::{Mat, at, damped_update, dot, mul, put};
-use super::qp::{self, QP_ROWS, QpError, Row, Rows};
+use super::qp;
+use super::step::{REGULARIZATION, StepRows, step};
 use super::{BfgsConfig, Bounds, OptimError, Outcome, Status, Vector};
 
 /// A step whose largest component is below this (m) is no step.
@@ -56,12 +70,6 @@ pub(crate) const STEP_TOL: f32 = 1e-3;
 
 /// `ρ` is kept at least this many times the largest group's multipliers.
 const RHO_FACTOR: f32 = 1.5;
-
-/// Relaxations of an incompatible QP: the share of each shortfall left.
-const RELAXATIONS: [f32; 4] = [0.0, 0.5, 0.9, 1.0];
-
-/// Relative regularization of the metric's diagonal in the QP.
-const REGULARIZATION: f32 = 1e-6;
 
 /// Most feasibility restorations of one run (each: one least-norm step
 /// onto the linearized constraints, from where the run goes on).
@@ -88,7 +96,8 @@ const STALLS: u32 = 5;
 /// (a restart near a finished run keeps its curvature), else the
 /// Gauss–Newton matrix at `z0`; the final metric on return. `rho0`: the
 /// merit weight to start from (m³/m; 0 learns it from the multipliers).
-/// A run that ends infeasible or worse than its best feasible iterate
+/// `careful`: the QP also takes the rows beyond the band its step would
+/// cross (module docs). A run that ends infeasible or worse than its best feasible iterate
 /// goes back to that iterate (`best.rs`). Returns the
 /// ℓ1 merit's final penalty weight and any row active at a one-sided kink
 /// at the end ([`SqpEnd`]).
@@ -97,7 +106,7 @@ const STALLS: u32 = 5;
 /// [`OptimError`] when the objective fails or is not finite at the start.
 pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     obj: &mut O,
-    (z0, metric, rho0): (&[f32; K], &mut Option<Mat<K>>, f32),
+    (z0, metric, rho0, careful): (&[f32; K], &mut Option<Mat<K>>, f32, bool),
     (bounds, n): (&Bounds<K>, usize),
     cfg: &BfgsConfig,
     feas_tol: f32,
@@ -117,6 +126,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         iterations: 0,
         skipped: 0,
         stalls: 0,
+        careful,
     };
     obj.linearize(&run.z, metric.is_none(), &mut run.lin)
         .map_err(OptimError::Start)?;
@@ -212,9 +222,29 @@ struct Run<const K: usize> {
     skipped: u32,
     /// Infeasible iterations in a row that left the merit unmoved.
     stalls: u32,
+    /// Whether the QP also takes the rows beyond the band its step would
+    /// cross.
+    careful: bool,
 }
 
 impl<const K: usize> Run<K> {
+    /// The QP step (`step.rs`); where the QP finds the metric not definite
+    /// in f32, the metric is reset to its diagonal and the step solved
+    /// again.
+    fn qp_step(
+        &mut self,
+        (bounds, n): (&Bounds<K>, usize),
+        max_step: f32,
+    ) -> Option<([f32; K], Vec<f32, CONSTRAINTS>, f32)> {
+        let (lin, z) = (&self.lin, &self.z);
+        let first = step(&self.a, lin, z, (bounds, n), (max_step, self.careful));
+        if first.is_some() {
+            return first;
+        }
+        self.a = diagonal(&self.a, n);
+        step(&self.a, lin, z, (bounds, n), (max_step, self.careful))
+    }
+
     /// One iteration: the QP step, the line search, the new linearization
     /// and the metric's update; `Some` with the status when the run ends.
     fn iterate<O: Constrained<K>>(
@@ -224,12 +254,7 @@ impl<const K: usize> Run<K> {
         cfg: &BfgsConfig,
         feas_tol: f32,
     ) -> Option<Status> {
-        let mut stepped = step(&self.a, &self.lin, &self.z, (bounds, n), cfg.max_step);
-        if stepped.is_none() {
-            // The metric, no longer definite in f32, reset to its diagonal.
-            self.a = diagonal(&self.a, n);
-            stepped = step(&self.a, &self.lin, &self.z, (bounds, n), cfg.max_step);
-        }
+        let stepped = self.qp_step((bounds, n), cfg.max_step);
         let lin = &self.lin;
         let Some((d, lambda, sigma)) = stepped else {
             return Some(Status::LineSearchFailed);
@@ -333,7 +358,7 @@ impl<const K: usize> Run<K> {
         for i in 0..n {
             put(&mut unit, i, i, 1.0);
         }
-        let rows = StepRows::new(&self.lin, (&self.z, bounds, n), 0.0);
+        let rows = StepRows::new(&self.lin, (&self.z, bounds, n), (0.0, self.lin.band));
         let Ok(sol) = qp::solve(&unit, &[0.0; K], n, &rows) else {
             return false;
         };
@@ -395,124 +420,6 @@ fn diagonal<const K: usize>(a: &Mat<K>, n: usize) -> Mat<K> {
             }
         })
     })
-}
-
-/// The QP step at `z`: `(d, λ per constraint row, σ)` with the least
-/// relaxation `σ` that makes the QP compatible; `None` when none does
-/// (the metric not definite).
-fn step<const K: usize>(
-    a: &Mat<K>,
-    lin: &Linearized<K>,
-    z: &[f32; K],
-    (bounds, n): (&Bounds<K>, usize),
-    max_step: f32,
-) -> Option<([f32; K], Vec<f32, CONSTRAINTS>, f32)> {
-    let mean = (0..n).fold(0.0, |s, i| s + at(a, i, i)) / (n.max(1) as f32);
-    let delta = REGULARIZATION * mean.max(0.0) + REGULARIZATION;
-    let mut a_reg = *a;
-    for i in 0..n {
-        put(&mut a_reg, i, i, at(a, i, i) + delta);
-    }
-    for &sigma in &RELAXATIONS {
-        let rows = StepRows::new(lin, (z, bounds, n), sigma);
-        match qp::solve(&a_reg, &lin.grad, n, &rows) {
-            Ok(sol) => {
-                let mut lambda: Vec<f32, CONSTRAINTS> = Vec::new();
-                for _ in 0..lin.rows {
-                    let _ = lambda.push(0.0);
-                }
-                for (i, &l) in sol.lambda.iter().enumerate().take(rows.general) {
-                    let at = rows.index.get(i).map(|&k| usize::from(k));
-                    if let Some(slot) = at.and_then(|k| lambda.get_mut(k)) {
-                        *slot = l;
-                    }
-                }
-                let longest = sol.d.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)));
-                let mut d = sol.d;
-                if longest > max_step {
-                    d.iter_mut().for_each(|v| *v *= max_step / longest);
-                }
-                return Some((d, lambda, sigma));
-            }
-            Err(QpError::Incompatible | QpError::Iterations) => {}
-            Err(QpError::NotDefinite) => return None,
-        }
-    }
-    None
-}
-
-/// The QP's rows at relaxation `σ`, read in place: the near-active
-/// constraints with a gradient (`index`: which of the objective's rows),
-/// then two box rows per variable around `z`.
-struct StepRows<'l, const K: usize> {
-    lin: &'l Linearized<K>,
-    index: [u8; CONSTRAINTS],
-    general: usize,
-    z: &'l [f32; K],
-    bounds: &'l Bounds<K>,
-    n: usize,
-    sigma: f32,
-}
-
-impl<'l, const K: usize> StepRows<'l, K> {
-    fn new(
-        lin: &'l Linearized<K>,
-        (z, bounds, n): (&'l [f32; K], &'l Bounds<K>, usize),
-        sigma: f32,
-    ) -> Self {
-        let mut index = [0_u8; CONSTRAINTS];
-        let mut general = 0_usize;
-        for (i, (c, a, _)) in lin.iter().enumerate() {
-            let moves = a.iter().take(n).any(|&v| v != 0.0);
-            if moves
-                && c < lin.band
-                && c.is_finite()
-                && let Some(slot) = index.get_mut(general)
-            {
-                *slot = u8::try_from(i).unwrap_or(u8::MAX);
-                general = general.saturating_add(1);
-            }
-        }
-        Self {
-            lin,
-            index,
-            general,
-            z,
-            bounds,
-            n,
-            sigma,
-        }
-    }
-}
-
-impl<const K: usize> Rows<K> for StepRows<'_, K> {
-    fn count(&self) -> usize {
-        self.general
-            .saturating_add(self.n.saturating_mul(2))
-            .min(QP_ROWS)
-    }
-
-    fn row(&self, i: usize) -> Option<Row<K>> {
-        if i < self.general {
-            let k = usize::from(*self.index.get(i)?);
-            let (&c, &a) = (self.lin.c.get(k)?, self.lin.a.get(k)?);
-            let c = if c < 0.0 { (1.0 - self.sigma) * c } else { c };
-            return Some(Row { a, c });
-        }
-        let b = i.checked_sub(self.general)?;
-        let (v, up) = (b / 2, b % 2 == 0);
-        let (&zi, &lo, &hi) = (
-            self.z.get(v)?,
-            self.bounds.lo.get(v)?,
-            self.bounds.hi.get(v)?,
-        );
-        let mut a = [0.0; K];
-        *a.get_mut(v)? = if up { 1.0 } else { -1.0 };
-        Some(Row {
-            a,
-            c: if up { zi - lo } else { hi - zi },
-        })
-    }
 }
 
 /// The largest sum of multipliers over one group (groups `0..K`; a row

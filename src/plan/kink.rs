@@ -53,7 +53,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let far = far && obj.last_violation <= tol;
         match self.kink_start(obj, bounds, g, far) {
             Ok(Some(z)) => self
-                .sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations)
+                .sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
                 .unwrap_or(iterations),
             Ok(None) | Err(_) => iterations,
         }

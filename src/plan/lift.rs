@@ -62,7 +62,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let Ok(Some(z)) = self.lift_start(obj, bounds, g, tol) else {
                 continue;
             };
-            if let Some(total) = self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations) {
+            if let Some(total) =
+                self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
+            {
                 iterations = total;
                 if iterations >= self.cfg.bfgs.max_iterations {
                     break;

@@ -149,7 +149,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut metric = None;
         let run = sqp_into(
             obj,
-            (z0, &mut metric, 0.0),
+            (z0, &mut metric, 0.0, false),
             (bounds, h),
             &self.cfg.bfgs,
             tol,
@@ -164,10 +164,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let rho = end.rho;
         let mut iterations = self.work.iterations;
         // Back at its best feasible iterate (`optim/best.rs`): once more from
-        // there, with the merit weight learnt.
+        // there, the merit weight learnt, careful (`optim/sqp.rs`).
         if end.returned && iterations < self.cfg.bfgs.max_iterations {
             let z = self.work.z;
-            let again = self.sqp_restart(obj, &z, (h, bounds), (tol, rho), iterations);
+            let again = self.sqp_restart(obj, &z, (h, bounds), (tol, rho, true), iterations);
             iterations = again.unwrap_or(iterations);
         }
         let mut scanned = 0_u64;
@@ -200,7 +200,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 }
             }
             let Some((_, z, bit)) = best else { break };
-            match self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations) {
+            match self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations) {
                 Some(total) => iterations = total,
                 None => break,
             }
@@ -219,7 +219,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// The SQP restarted from `z` with the merit weight `rho` (m³/m; 0:
-    /// learnt afresh), kept if it ends better than the workspace's: feasible
+    /// learnt afresh), `careful` of the rows beyond the band or not
+    /// (`optim/sqp.rs`), kept if it ends better than the workspace's: feasible
     /// and lower, or, from an infeasible optimum, less infeasible. Returns
     /// the iterations so far when kept.
     pub(super) fn sqp_restart(
@@ -227,7 +228,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         obj: &mut PlanObjective<'_, N>,
         z: &[f32; K],
         (h, bounds): (usize, &Bounds<K>),
-        (tol, rho): (f32, f32),
+        (tol, rho, careful): (f32, f32, bool),
         iterations: u32,
     ) -> Option<u32> {
         let kept = self.work.mark();
@@ -247,7 +248,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut fresh = None;
         let restart = sqp_into(
             obj,
-            (z, &mut fresh, rho),
+            (z, &mut fresh, rho, careful),
             (bounds, h),
             &left,
             tol,

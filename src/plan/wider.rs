@@ -59,7 +59,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if scan_start(fl, &spec, &mut z, &mut curvature, &mut log).is_err() {
             return iterations;
         }
-        self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0), iterations)
+        self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
             .unwrap_or(iterations)
     }
 }
