@@ -1085,6 +1085,18 @@ fn the_sqp_ends_no_worse_than_its_best_feasible_point() {
     horizon_within("best_feasible", 1.10, 8.27996e7);
 }
 
+/// A feasibility restoration that falls short is carried on along the
+/// secant of `v` (`optim/sqp.rs`, `Run::restore`): on the same line the
+/// restoration's least step cut the shortfall only from 92.5 to 85.3 m
+/// (the rows' gradients overstate their slopes there); halved, it did no
+/// better, the restoration gave up and the line ended on a worse optimum:
+/// `J` 8.36830e7 m³, 1.0107× the best safe. Carried on along the secant
+/// (4 steps' length), the shortfall is 0, and `J` 8.2810e7 (1.0001×).
+#[test]
+fn a_short_restoration_is_carried_on_along_its_secant() {
+    horizon_within("best_feasible", 1.005, 8.27996e7);
+}
+
 /// A later track held at its target by the depth before it: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 60606`,
 /// `unseen_60606_0`) the cold SQP ended with track 1 at 662.6 m (a

@@ -80,6 +80,10 @@ const RESTORATIONS: u32 = 3;
 /// otherwise buy shavings of `v` with gradient evaluations).
 const RESTORED: f32 = 0.5;
 
+/// A restoration step that cut `v` by less than [`RESTORED`] is extended
+/// along the secant of `v` to zero, by at most this factor.
+const SECANT_REACH: f32 = 4.0;
+
 /// Infeasible iterations in a row that leave the merit `φ` unmoved (within
 /// the relative tolerance) before the run counts as stalled: on an
 /// infeasible random line (`check_planner.py --seed 43`, `unseen_43_6`)
@@ -344,8 +348,11 @@ impl<const K: usize> Run<K> {
 impl<const K: usize> Run<K> {
     /// Feasibility restoration (N&W §18.4's spirit, without `J`): the
     /// least step in the Euclidean norm onto the linearized constraints,
-    /// halved (at most 3 times) until the infeasibility `v` is at most
-    /// [`RESTORED`] of what it was; at the
+    /// halved where it makes `v` no smaller and extended along the secant
+    /// of `v` to zero where it cuts `v` by less (at most 3 times), until
+    /// the infeasibility `v` is at most [`RESTORED`] of what it was (where
+    /// the row's gradient overstates its slope, as a depth loop's
+    /// conditional integration makes it, the full step falls short); at the
     /// point reached, a new linearization and the Gauss–Newton metric (the
     /// one that failed was built on the other side of a kink). True when
     /// it moved.
@@ -384,6 +391,9 @@ impl<const K: usize> Run<K> {
                     self.iterations = self.iterations.saturating_add(1);
                     return true;
                 }
+                // Progress short of the share: on along the secant of `v`
+                // to zero (the linearization underestimated the step).
+                Ok((_, v)) if v < v0 => alpha *= (v0 / (v0 - v)).min(SECANT_REACH),
                 Ok(_) => alpha *= 0.5,
                 Err(_) => return false,
             }
