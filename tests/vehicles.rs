@@ -98,3 +98,22 @@ fn a_row_beyond_the_band_is_not_crossed_unseen() {
 fn a_crossed_row_on_a_second_order_vehicle() {
     horizon_within("careful_second", 1.01, 3.229_877e7);
 }
+
+/// An interior optimum after a trip is polished too (`polish.rs`):
+/// `check_planner.py --seed 1203 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_1203_2`, constrained
+/// track by track. Track 3's optimizer left the safe set, ran again from
+/// the boundary to an interior optimum, and ended in a tooth at 822.01 m:
+/// `J` 6 026.6 m³, 1.021× the best safe 5 902.07 m³ (820.75 m) from the
+/// state the tool's own tracks 1 and 2 leave. Polished: 820.51 m, 1.0017×.
+#[test]
+fn an_interior_optimum_after_a_trip_is_read_at_its_trend() {
+    let (p, w, c) = fixture("interior_sawtooth");
+    let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
+    let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
+    let tracks = v["tracks"].as_array().unwrap();
+    let d2 = tracks[1]["depth"].as_f64().unwrap();
+    assert!((d2 - 892.668).abs() < 0.01, "track 2 at {d2}: not the premise");
+    let j = tracks[2]["J"].as_f64().unwrap();
+    assert!(j <= 1.005 * 5_902.07, "track 3: J {j} vs the best safe");
+}

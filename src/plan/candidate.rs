@@ -356,8 +356,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `z_bad`, a finite difference of `CHECK_STEP` or, if not, of a
     /// quarter of it), the optimum is
     /// interior and the guarded optimizer runs once more from the boundary
-    /// (its steps only lower `J`); its candidate unless it trips again.
-    /// Unbudgeted calls only (the budgeted ones keep the boundary).
+    /// (its steps only lower `J`), then the polish (`polish.rs`) under
+    /// BFGS; its candidate unless it trips again. Unbudgeted calls only
+    /// (the budgeted ones keep the boundary).
     fn inward(
         &mut self,
         fl: &mut Flights<'_, '_, N>,
@@ -389,6 +390,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if obj.tripped.is_some() || ran.is_err() {
             fl.count = fl.count.saturating_add(obj.evaluations);
             return Ok(None);
+        }
+        // (An interior optimum, as the unconstrained track's: where the
+        // depth loop integrates, `J` may be a sawtooth there.)
+        if self.cfg.method == Method::Bfgs {
+            let guard = obj.guard;
+            self.polish_single(obj, &s.bounds, guard);
         }
         let last = obj.last_flight;
         let answer = (self.work.iterations, None);
