@@ -1097,6 +1097,21 @@ fn a_short_restoration_is_carried_on_along_its_secant() {
     horizon_within("best_feasible", 1.005, 8.27996e7);
 }
 
+/// A run that went back to its start from a lower `J` restarts at the
+/// edge of the feasible set between the two (`src/plan/edge.rs`): on a
+/// random canyon line (`tools/reference/check_planner.py --unseen 8
+/// --seed 1302`, `unseen_1302_7`) track 1's least altitude falls from
+/// 80 m at 501.7 m to 60 m at 556.3 m and then stays at 59.75 m (a dive
+/// held at the pitch limit); a plateau restart went from 501.7 to 674 m,
+/// 0.27 m short with no gradient to return by, and back: the line's `J`
+/// 3.6577e7 m³, 1.81× the f64 beam search's best safe plan (2.02082e7 m³,
+/// track 1 at 556.3 m). From the edge, 1.0028×. The checker's bound is
+/// 1.10×.
+#[test]
+fn a_run_gone_back_restarts_at_the_edge_it_crossed() {
+    horizon_within("edge_saturated", 1.01, 2.02082e7);
+}
+
 /// A later track held at its target by the depth before it: on a random
 /// canyon line (`tools/reference/check_planner.py --unseen 8 --seed 60606`,
 /// `unseen_60606_0`) the cold SQP ended with track 1 at 662.6 m (a

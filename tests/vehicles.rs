@@ -113,7 +113,10 @@ fn an_interior_optimum_after_a_trip_is_read_at_its_trend() {
     let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
     let tracks = v["tracks"].as_array().unwrap();
     let d2 = tracks[1]["depth"].as_f64().unwrap();
-    assert!((d2 - 892.668).abs() < 0.01, "track 2 at {d2}: not the premise");
+    assert!(
+        (d2 - 892.668).abs() < 0.01,
+        "track 2 at {d2}: not the premise"
+    );
     let j = tracks[2]["J"].as_f64().unwrap();
     assert!(j <= 1.005 * 5_902.07, "track 3: J {j} vs the best safe");
 }

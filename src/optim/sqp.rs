@@ -115,7 +115,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     cfg: &BfgsConfig,
     feas_tol: f32,
     out: &mut Outcome<K>,
-) -> Result<SqpEnd, OptimError<O::Error>> {
+) -> Result<SqpEnd<K>, OptimError<O::Error>> {
     cfg.validate().map_err(OptimError::Config)?;
     if !bounds.is_valid() {
         return Err(OptimError::Config(super::OptimConfigError::Bounds));
@@ -167,10 +167,9 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
             break stop;
         }
     };
+    let (left, left_j) = (run.z, run.lin.j);
     let returned = best.return_to(obj, (&mut run.z, &mut run.lin), (feas_tol, &cfg.tol));
-    if returned {
-        run.evaluations = run.evaluations.saturating_add(1);
-    }
+    run.evaluations = run.evaluations.saturating_add(u32::from(returned));
     let z = Vector::from(run.z);
     out.z = run.z;
     out.j = run.lin.j;
@@ -185,12 +184,13 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         rho: run.rho,
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
         returned,
+        left: (returned && left_j < run.lin.j).then_some(left),
     })
 }
 
 /// What a run leaves beside its [`Outcome`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(crate) struct SqpEnd {
+pub(crate) struct SqpEnd<const K: usize> {
     /// The ℓ1 merit's final penalty weight `ρ` (m³ of `J` per m of `v`;
     /// 0 when no constraint was ever active).
     pub rho: f32,
@@ -200,6 +200,8 @@ pub(crate) struct SqpEnd {
     /// Whether the run went back to its best feasible iterate
     /// (`best.rs`).
     pub returned: bool,
+    /// Where it ended before it went back, if its `J` was lower there.
+    pub left: Option<[f32; K]>,
 }
 
 /// How close to zero (m) a row's `c` counts as active at the end: the

@@ -138,6 +138,7 @@ mod candidate;
 mod certify;
 mod commit;
 mod config;
+mod edge;
 mod fallback;
 mod flights;
 mod gaps;

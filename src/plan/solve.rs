@@ -163,10 +163,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let end = run.map_err(start_error)?;
         let rho = end.rho;
         let mut iterations = self.work.iterations;
-        // Back at its best feasible iterate (`optim/best.rs`): once more from
-        // there, the merit weight learnt, careful (`optim/sqp.rs`).
+        // Gone back (`optim/best.rs`): once more, careful, the merit weight
+        // learnt, from there or the edge towards where it left (`edge.rs`).
         if end.returned && iterations < self.cfg.bfgs.max_iterations {
-            let z = self.work.z;
+            let edge = end.left.and_then(|l| self.edge_toward(obj, &l, tol));
+            let z = edge.unwrap_or(self.work.z);
             let again = self.sqp_restart(obj, &z, (h, bounds), (tol, rho, true), iterations);
             iterations = again.unwrap_or(iterations);
         }
@@ -254,6 +255,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             tol,
             &mut self.work,
         );
+        // Gone back to its start, from a lower `J`: once more from the
+        // edge between them (`edge.rs`), kept if better than the start.
+        if let Ok(end) = &restart
+            && let Some(e) = end.left.and_then(|l| self.edge_toward(obj, &l, tol))
+        {
+            self.restart_at_edge(obj, &e, (h, bounds), (tol, &left));
+        }
         let acc = &mut self.work;
         let v = obj.last_violation;
         let better = restart.is_ok()
@@ -268,6 +276,35 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         obj.last_violation = kept_v;
         acc.restore(&kept);
         None
+    }
+
+    /// A careful SQP run from the edge `e` (`edge.rs`) with `cfg`, kept on
+    /// the workspace if it ends feasible within `tol` (m) and lower than
+    /// the workspace's feasible point it replaces.
+    fn restart_at_edge(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        e: &[f32; K],
+        (h, bounds): (usize, &Bounds<K>),
+        (tol, cfg): (f32, &BfgsConfig),
+    ) {
+        let mid = self.work.mark();
+        let mid_v = obj.last_violation;
+        let mut fresh = None;
+        let run = sqp_into(
+            obj,
+            (e, &mut fresh, 0.0, true),
+            (bounds, h),
+            cfg,
+            tol,
+            &mut self.work,
+        );
+        let acc = &self.work;
+        let lower = acc.j.partial_cmp(&mid.j) == Some(core::cmp::Ordering::Less);
+        if !(run.is_ok() && obj.last_violation <= tol && lower) {
+            obj.last_violation = mid_v;
+            self.work.restore(&mid);
+        }
     }
 
     /// Further penalty stages: each re-solves from the last optimum with
