@@ -221,9 +221,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The SQP restarted from `z` with the merit weight `rho` (m³/m; 0:
     /// learnt afresh), `careful` of the rows beyond the band or not
-    /// (`optim/sqp.rs`), kept if it ends better than the workspace's: feasible
-    /// and lower, or, from an infeasible optimum, less infeasible. Returns
-    /// the iterations so far when kept.
+    /// (`optim/sqp.rs`), kept if it ends better than the workspace's:
+    /// feasible and lower, or, from an infeasible optimum, less
+    /// infeasible. A restart gone back to its start from a lower `J` runs
+    /// once more, careful, from the edge between them (`edge.rs`), kept
+    /// on the same terms. Returns the iterations so far when kept.
     pub(super) fn sqp_restart(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
@@ -232,79 +234,60 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         (tol, rho, careful): (f32, f32, bool),
         iterations: u32,
     ) -> Option<u32> {
-        let kept = self.work.mark();
-        let kept_v = obj.last_violation;
-        let left = BfgsConfig {
-            max_iterations: self
-                .cfg
-                .bfgs
-                .max_iterations
-                .saturating_sub(iterations)
-                .saturating_sub(1)
-                .max(1),
-            ..self.cfg.bfgs
-        };
-        // (A fresh metric: the plateau's row of the finished one is empty,
-        // its step there would be unbounded.)
-        let mut fresh = None;
-        let restart = sqp_into(
-            obj,
-            (z, &mut fresh, rho, careful),
-            (bounds, h),
-            &left,
-            tol,
-            &mut self.work,
-        );
-        // Gone back to its start, from a lower `J`: once more from the
-        // edge between them (`edge.rs`), kept if better than the start.
-        if let Ok(end) = &restart
-            && let Some(e) = end.left.and_then(|l| self.edge_toward(obj, &l, tol))
-        {
-            self.restart_at_edge(obj, &e, (h, bounds), (tol, &left));
-        }
-        let acc = &mut self.work;
-        let v = obj.last_violation;
-        let better = restart.is_ok()
-            && if kept_v > tol {
-                v < kept_v
-            } else {
-                v <= tol && acc.j.partial_cmp(&kept.j) == Some(core::cmp::Ordering::Less)
+        let (mut from, mut careful, mut total) = (*z, careful, None::<u32>);
+        for round in 0..2 {
+            let kept = self.work.mark();
+            let kept_v = obj.last_violation;
+            let so_far = total.unwrap_or(iterations);
+            let left = BfgsConfig {
+                max_iterations: self
+                    .cfg
+                    .bfgs
+                    .max_iterations
+                    .saturating_sub(so_far)
+                    .saturating_sub(1)
+                    .max(1),
+                ..self.cfg.bfgs
             };
-        if better {
-            return Some(iterations.saturating_add(acc.iterations).saturating_add(1));
+            // (A fresh metric: the plateau's row of the finished one is
+            // empty, its step there would be unbounded.)
+            let mut fresh = None;
+            let restart = sqp_into(
+                obj,
+                (&from, &mut fresh, rho, careful),
+                (bounds, h),
+                &left,
+                tol,
+                &mut self.work,
+            );
+            let acc = &mut self.work;
+            let v = obj.last_violation;
+            let better = restart.is_ok()
+                && if kept_v > tol {
+                    v < kept_v
+                } else {
+                    v <= tol && acc.j.partial_cmp(&kept.j) == Some(core::cmp::Ordering::Less)
+                };
+            // (The edge from where the run went back, before any restore.)
+            let edge = restart
+                .ok()
+                .and_then(|end| end.left)
+                .filter(|_| round == 0)
+                .and_then(|l| self.edge_toward(obj, &l, tol));
+            if better {
+                total = Some(
+                    so_far
+                        .saturating_add(self.work.iterations)
+                        .saturating_add(1),
+                );
+            } else {
+                obj.last_violation = kept_v;
+                self.work.restore(&kept);
+            }
+            let Some(e) = edge else { break };
+            (from, careful) = (e, true);
         }
-        obj.last_violation = kept_v;
-        acc.restore(&kept);
-        None
-    }
-
-    /// A careful SQP run from the edge `e` (`edge.rs`) with `cfg`, kept on
-    /// the workspace if it ends feasible within `tol` (m) and lower than
-    /// the workspace's feasible point it replaces.
-    fn restart_at_edge(
-        &mut self,
-        obj: &mut PlanObjective<'_, N>,
-        e: &[f32; K],
-        (h, bounds): (usize, &Bounds<K>),
-        (tol, cfg): (f32, &BfgsConfig),
-    ) {
-        let mid = self.work.mark();
-        let mid_v = obj.last_violation;
-        let mut fresh = None;
-        let run = sqp_into(
-            obj,
-            (e, &mut fresh, 0.0, true),
-            (bounds, h),
-            cfg,
-            tol,
-            &mut self.work,
-        );
-        let acc = &self.work;
-        let lower = acc.j.partial_cmp(&mid.j) == Some(core::cmp::Ordering::Less);
-        if !(run.is_ok() && obj.last_violation <= tol && lower) {
-            obj.last_violation = mid_v;
-            self.work.restore(&mid);
-        }
+        total
     }
 
     /// Further penalty stages: each re-solves from the last optimum with
