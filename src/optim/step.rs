@@ -32,11 +32,41 @@ pub(super) fn step<const K: usize>(
     for i in 0..n {
         put(&mut a_reg, i, i, at(a, i, i) + delta);
     }
-    let near = step_within(&a_reg, lin, (z, bounds, n), max_step, lin.band)?;
-    if careful && lin.band.is_finite() && crosses(lin, &near.0, n) {
-        return step_within(&a_reg, lin, (z, bounds, n), max_step, f32::INFINITY);
+    // (One frame for both solves: two calls of a helper that returned
+    // the step grew the horizon's stack by 440 B on the M4F.)
+    let mut band = lin.band;
+    'bands: loop {
+        for &sigma in &RELAXATIONS {
+            let rows = StepRows::new(lin, (z, bounds, n), (sigma, band));
+            match qp::solve(&a_reg, &lin.grad, n, &rows) {
+                Ok(sol) => {
+                    let longest = sol.d.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)));
+                    let mut d = sol.d;
+                    if longest > max_step {
+                        d.iter_mut().for_each(|v| *v *= max_step / longest);
+                    }
+                    if careful && band.is_finite() && crosses(lin, &d, n) {
+                        band = f32::INFINITY;
+                        continue 'bands;
+                    }
+                    let mut lambda: Vec<f32, CONSTRAINTS> = Vec::new();
+                    for _ in 0..lin.rows {
+                        let _ = lambda.push(0.0);
+                    }
+                    for (i, &l) in sol.lambda.iter().enumerate().take(rows.general) {
+                        let at = rows.index.get(i).map(|&k| usize::from(k));
+                        if let Some(slot) = at.and_then(|k| lambda.get_mut(k)) {
+                            *slot = l;
+                        }
+                    }
+                    return Some((d, lambda, sigma));
+                }
+                Err(QpError::Incompatible | QpError::Iterations) => {}
+                Err(QpError::NotDefinite) => return None,
+            }
+        }
+        return None;
     }
-    Some(near)
 }
 
 /// Whether the step `d` crosses, by the linearization, a row left out of
@@ -44,43 +74,6 @@ pub(super) fn step<const K: usize>(
 fn crosses<const K: usize>(lin: &Linearized<K>, d: &[f32; K], n: usize) -> bool {
     lin.iter()
         .any(|(c, a, _)| c >= lin.band && c.is_finite() && c + dot(a, d, n) < 0.0)
-}
-
-/// [`step`]'s QP on the rows with `c` below `band` (m), the metric
-/// regularized.
-fn step_within<const K: usize>(
-    a_reg: &Mat<K>,
-    lin: &Linearized<K>,
-    (z, bounds, n): (&[f32; K], &Bounds<K>, usize),
-    max_step: f32,
-    band: f32,
-) -> Option<([f32; K], Vec<f32, CONSTRAINTS>, f32)> {
-    for &sigma in &RELAXATIONS {
-        let rows = StepRows::new(lin, (z, bounds, n), (sigma, band));
-        match qp::solve(a_reg, &lin.grad, n, &rows) {
-            Ok(sol) => {
-                let mut lambda: Vec<f32, CONSTRAINTS> = Vec::new();
-                for _ in 0..lin.rows {
-                    let _ = lambda.push(0.0);
-                }
-                for (i, &l) in sol.lambda.iter().enumerate().take(rows.general) {
-                    let at = rows.index.get(i).map(|&k| usize::from(k));
-                    if let Some(slot) = at.and_then(|k| lambda.get_mut(k)) {
-                        *slot = l;
-                    }
-                }
-                let longest = sol.d.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)));
-                let mut d = sol.d;
-                if longest > max_step {
-                    d.iter_mut().for_each(|v| *v *= max_step / longest);
-                }
-                return Some((d, lambda, sigma));
-            }
-            Err(QpError::Incompatible | QpError::Iterations) => {}
-            Err(QpError::NotDefinite) => return None,
-        }
-    }
-    None
 }
 
 /// The QP's rows at relaxation `σ`, read in place: the near-active
