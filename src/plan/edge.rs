@@ -25,11 +25,11 @@ use crate::optim::sqp::Constrained;
 const BISECTIONS: u32 = 8;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
-    /// The point of the segment from the workspace's depths (feasible
-    /// within `tol`, m) to `left` furthest along it found feasible by
-    /// bisection, if its `J` is lower than the workspace's; `None` also
-    /// when a flight fails or the budget stops it. Plain flights, counted
-    /// in `obj`'s evaluations.
+    /// The edge of the feasible set (within `tol`, m) on the segment from
+    /// the workspace's depths to `left`, by bisection: of the points it
+    /// found feasible, the one of lowest `J`, if lower than the
+    /// workspace's; `None` also when a flight fails or the budget stops
+    /// it. Plain flights, counted in `obj`'s evaluations.
     pub(super) fn edge_toward(
         &self,
         obj: &mut PlanObjective<'_, N>,
