@@ -168,6 +168,18 @@ pub(crate) fn max(a: f32, b: f32) -> f32 {
     if b > a { b } else { a }
 }
 
+/// The point `a + t (b − a)` of the segment from `a` to `b` (m), per
+/// entry.
+pub(crate) fn between<const L: usize>(a: &[f32; L], b: &[f32; L], t: f32) -> [f32; L] {
+    core::array::from_fn(|i| {
+        let (ai, bi) = (
+            a.get(i).copied().unwrap_or(0.0),
+            b.get(i).copied().unwrap_or(0.0),
+        );
+        ai + t * (bi - ai)
+    })
+}
+
 /// Degrees to radians, as f32.
 pub(crate) const DEG: f32 = core::f32::consts::PI / 180.0;
 

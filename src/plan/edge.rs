@@ -37,13 +37,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
     ) -> Option<[f32; K]> {
         let (from, j0) = (self.work.z, self.work.j);
-        let at = |t: f32| -> [f32; K] {
-            core::array::from_fn(|i| {
-                let (a, b) = (from.get(i).copied(), left.get(i).copied());
-                let (a, b) = (a.unwrap_or(0.0), b.unwrap_or(0.0));
-                a + t * (b - a)
-            })
-        };
+        let at = |t: f32| crate::num::between(&from, left, t);
         let (mut lo, mut hi) = (0.0_f32, 1.0_f32);
         let mut best: Option<([f32; K], f32)> = None;
         for _ in 0..BISECTIONS {

@@ -56,15 +56,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         h_safe: f32,
         flights: &mut u32,
     ) -> Chosen<N> {
-        let at = |t: f32| -> [f32; MAX_TRACKS] {
-            core::array::from_fn(|i| {
-                let (ai, ci) = (
-                    a.get(i).copied().unwrap_or(0.0),
-                    c.get(i).copied().unwrap_or(0.0),
-                );
-                ai + t * (ci - ai)
-            })
-        };
+        let at = |t: f32| -> [f32; MAX_TRACKS] { crate::num::between(a, c, t) };
         let m = sc.mission();
         let rule = RootTol {
             tol: (SEARCH_SHARE * (m.reference_altitude() - m.min_altitude())).clamp(1e-3, 0.02),
