@@ -10,7 +10,7 @@
 
 mod tool;
 
-use tool::{fixture, json_of};
+use tool::{fixture, json_of, tracks_of};
 
 /// Track-wise with a slower vehicle (`check_planner.py --seed 53
 /// --vehicle`, `unseen_53_7`: 1 m/s, `Ts` 0.2 s, 30° limits, another
@@ -42,15 +42,7 @@ fn a_flat_track_start_is_no_boundary() {
 /// (1 014.85 m).
 #[test]
 fn a_corner_near_the_unsafe_end_is_reached() {
-    let (p, w, c) = fixture("far_corner");
-    let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
-    let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
-    let tracks = v["tracks"].as_array().unwrap();
-    let d1 = tracks[0]["depth"].as_f64().unwrap();
-    assert!(
-        (d1 - 1016.556).abs() < 0.01,
-        "track 1 at {d1}: not the premise"
-    );
+    let tracks = tracks_of("far_corner", &["--mode", "track"], &[(0, 1016.556)]);
     let t2 = &tracks[1];
     let j2 = t2["J"].as_f64().unwrap();
     assert_eq!(t2["safe"], true, "{t2}");

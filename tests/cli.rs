@@ -17,7 +17,7 @@
 
 mod tool;
 
-use tool::{fixture, json_of, run, tool};
+use tool::{fixture, horizon_within, json_of, run, tool};
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -1044,17 +1044,6 @@ fn a_warm_last_track_stays_by_its_boundary() {
         j5 <= 1.01 * 2.319_15e6,
         "track 5: J {j5} vs the best safe 2.319 15e6 at 137.15 m"
     );
-}
-
-/// The horizon plan of fixture `name` (default vehicle) is safe and its
-/// line `J` within `ratio` of `best` (m³), the f64 beam search's best safe
-/// plan.
-fn horizon_within(name: &str, ratio: f64, best: f64) {
-    let (p, w, _) = fixture(name);
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(total <= ratio * best, "J {total} vs the best safe {best}");
 }
 
 /// The horizon's plateau escape rescans, in its second round, what its

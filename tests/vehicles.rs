@@ -10,15 +10,10 @@
 
 mod tool;
 
-use tool::{fixture, json_of};
+use tool::{horizon_within, tracks_of};
 
-/// The tracks of `plan --mode track --unconstrained` on fixture `name`.
-fn unconstrained_tracks(name: &str) -> Vec<serde_json::Value> {
-    let (p, w, c) = fixture(name);
-    let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
-    let v = json_of(&[&args[..], &["--mode", "track", "--unconstrained", "--json"]].concat());
-    v["tracks"].as_array().unwrap().clone()
-}
+/// `plan --mode track --unconstrained`.
+const UNCONSTRAINED: [&str; 3] = ["--mode", "track", "--unconstrained"];
 
 /// A sawtooth (`check_planner.py --seed 51`, `unseen_51_0`, track 1): `J`
 /// jumps +181 m³ every 6.5 cm of depth on a trend of +1 800 m³/m, and
@@ -27,7 +22,7 @@ fn unconstrained_tracks(name: &str) -> Vec<serde_json::Value> {
 /// 4.17473e5 m³ (657.5 m).
 #[test]
 fn a_sawtooth_is_read_at_its_trend() {
-    let t = &unconstrained_tracks("sawtooth")[0];
+    let t = &tracks_of("sawtooth", &UNCONSTRAINED, &[])[0];
     let j = t["J"].as_f64().unwrap();
     assert!(j <= 1.005 * 4.174_73e5, "track 1: J {j} vs the best");
 }
@@ -38,12 +33,7 @@ fn a_sawtooth_is_read_at_its_trend() {
 /// fallen 0.6 % in its last iteration.
 #[test]
 fn a_staircase_is_read_at_its_trend() {
-    let tracks = unconstrained_tracks("staircase");
-    let d1 = tracks[0]["depth"].as_f64().unwrap();
-    assert!(
-        (d1 - 964.197).abs() < 0.01,
-        "track 1 at {d1}: not the premise"
-    );
+    let tracks = tracks_of("staircase", &UNCONSTRAINED, &[(0, 964.197)]);
     let j = tracks[1]["J"].as_f64().unwrap();
     assert!(j <= 1.005 * 1.562_91e5, "track 2: J {j} vs the best");
 }
@@ -57,21 +47,7 @@ fn a_staircase_is_read_at_its_trend() {
 /// search's best safe 4.16939e7 m³ (`src/plan/wider.rs`).
 #[test]
 fn a_low_authority_vehicle_starts_again_wider() {
-    let (p, w, c) = fixture("low_authority");
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--config", &c, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(total <= 1.10 * 4.169_39e7, "J {total} vs the best safe");
-}
-
-/// `plan --json` (the horizon) on fixture `name` with its vehicle: safe,
-/// and the line's `J` within `ratio` of the f64 beam search's `best`.
-fn horizon_within(name: &str, ratio: f64, best: f64) {
-    let (p, w, c) = fixture(name);
-    let v = json_of(&["--profile", &p, "--waypoints", &w, "--config", &c, "--json"]);
-    let total = v["total_J"].as_f64().unwrap();
-    assert_eq!(v["safe"], true);
-    assert!(total <= ratio * best, "J {total} vs the best safe {best}");
+    horizon_within("low_authority", 1.10, 4.169_39e7);
 }
 
 /// A row beyond the QP's band, crossed unseen (`check_planner.py --seed
@@ -108,15 +84,7 @@ fn a_crossed_row_on_a_second_order_vehicle() {
 /// state the tool's own tracks 1 and 2 leave. Polished: 820.51 m, 1.0017×.
 #[test]
 fn an_interior_optimum_after_a_trip_is_read_at_its_trend() {
-    let (p, w, c) = fixture("interior_sawtooth");
-    let args = ["--profile", &p, "--waypoints", &w, "--config", &c];
-    let v = json_of(&[&args[..], &["--mode", "track", "--json"]].concat());
-    let tracks = v["tracks"].as_array().unwrap();
-    let d2 = tracks[1]["depth"].as_f64().unwrap();
-    assert!(
-        (d2 - 892.668).abs() < 0.01,
-        "track 2 at {d2}: not the premise"
-    );
+    let tracks = tracks_of("interior_sawtooth", &["--mode", "track"], &[(1, 892.668)]);
     let j = tracks[2]["J"].as_f64().unwrap();
     assert!(j <= 1.005 * 5_902.07, "track 3: J {j} vs the best safe");
 }

@@ -55,3 +55,42 @@ pub fn fixture(name: &str) -> (String, String, String) {
         format!("{dir}/{name}.toml"),
     )
 }
+
+/// `plan ARGS... --json` on fixture `name`, with its vehicle where
+/// `NAME.toml` exists (else the default vehicle): the JSON output.
+pub fn json_of_fixture(name: &str, args: &[&str]) -> serde_json::Value {
+    let (p, w, c) = fixture(name);
+    let mut all = vec!["--profile", &p, "--waypoints", &w];
+    if std::path::Path::new(&c).exists() {
+        all.extend(["--config", &c]);
+    }
+    all.extend(args);
+    all.push("--json");
+    json_of(&all)
+}
+
+/// The horizon plan of fixture `name` is safe and its line `J` within
+/// `ratio` of `best` (m³), the f64 beam search's best safe plan.
+pub fn horizon_within(name: &str, ratio: f64, best: f64) {
+    let v = json_of_fixture(name, &[]);
+    let total = v["total_J"].as_f64().unwrap();
+    assert_eq!(v["safe"], true);
+    assert!(total <= ratio * best, "J {total} vs the best safe {best}");
+}
+
+/// The tracks of `plan ARGS... --json` on fixture `name`, after checking
+/// the premise: track `i`'s depth within 1 cm of `depth` (m) for each
+/// `(i, depth)` of `premise`.
+pub fn tracks_of(name: &str, args: &[&str], premise: &[(usize, f64)]) -> Vec<serde_json::Value> {
+    let v = json_of_fixture(name, args);
+    let tracks = v["tracks"].as_array().unwrap().clone();
+    for &(i, z) in premise {
+        let d = tracks[i]["depth"].as_f64().unwrap();
+        assert!(
+            (d - z).abs() < 0.01,
+            "track {} at {d}: not the premise",
+            i + 1
+        );
+    }
+    tracks
+}
