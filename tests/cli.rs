@@ -1114,6 +1114,23 @@ fn a_later_track_dives_once_the_one_before_is_lifted() {
     horizon_within("lift_earlier", 1.10, 1.534436e7);
 }
 
+/// A lift that frees the later track's whole dive, not only the altitude
+/// it gains at the later track's own depth: on a random canyon line
+/// (`tools/reference/check_planner.py --unseen 8 --seed 1302`,
+/// `unseen_1302_5`) the cold SQP held track 5 at its target at 1 056.7 m
+/// by track 4's depth (942.7 m). Lifted 80 m, track 5's least altitude is
+/// 93.4 m at every depth below 1 070 m (a saturated dive's plateau, set
+/// by track 4 alone); the lift took the 13 m freed beyond the band
+/// (1 070 m, a start worse than the SQP's end) and the line's `J` was
+/// 7.551e6 m³, 1.40× the f64 beam search's best safe plan (5.410706e6 m³:
+/// 1028.4, 1048.1, 965.9, 896.0, 1474.0 m). Now the lift also tries track
+/// 5 at its preferred depth and narrows the least lift that clears it:
+/// 1.001×. The checker's bound is 1.10×.
+#[test]
+fn a_lift_that_clears_a_plateau_frees_the_whole_dive() {
+    horizon_within("lift_plateau", 1.01, 5.410706e6);
+}
+
 /// A climb bought for a dive: on a random canyon line
 /// (`tools/reference/check_planner.py --unseen 8 --seed 90317`,
 /// `unseen_90317_0`) track 4 crosses a rise 130 m above its deep end. The

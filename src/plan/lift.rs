@@ -15,7 +15,12 @@
 //! within the box). At each lift, track `g`'s least altitude is measured
 //! at its own depth (one flight of the two tracks): where it clears the
 //! target by the band, depth `g` is deepened by what was freed beyond the
-//! band. Where it does not, and track `g` is held more than the band
+//! band; and where track `g` at its preferred depth clears its target at
+//! the same lift (its least altitude set by track `g − 1` alone, a
+//! saturated dive's plateau), the least lift that frees that depth is
+//! narrowed too, and the start with the lower horizon `J` is taken
+//! (`unseen_1302_5`: 1.40× → 1.001×; the freed start there was worse than
+//! the SQP's end). Where it does not, and track `g` is held more than the band
 //! above its preferred depth (its bottom's mean less `h_r`), the lift that
 //! lets track `g` fly its preferred depth is sought instead: a dive from
 //! a shallower start passes a rise of the bottom higher, so a climb on
@@ -118,13 +123,22 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // (A freed start is kept within the band of feasible, as the SQP
         // left it; a start at the preferred depth may be far from it, the
         // climb saturated, and the restart's first steps close that.)
-        let (start, most) = match l.search(obj, z)? {
-            Next::Freed(start) => (start, band),
-            Next::Deep(lifts) => (l.narrowed(obj, z, lifts)?, f32::INFINITY),
+        let (freed, deep) = match l.search(obj, z)? {
+            Next::Freed(start) => (Some(start), None),
+            Next::Deep(lifts) => (None, Some(l.narrowed(obj, z, lifts)?)),
+            Next::Both(start, lifts) => (Some(start), Some(l.narrowed(obj, z, lifts)?)),
             Next::Nothing => return Ok(None),
         };
-        let (jz, v) = obj.tail_value(&head, (&at_j, j), &start)?;
-        Ok((v <= most && jz < self.work.j).then_some(start))
+        // The start whose horizon `J` is lowest, below the SQP's.
+        let mut best: Option<([f32; K], f32)> = None;
+        for (start, most) in [(freed, band), (deep, f32::INFINITY)] {
+            let Some(start) = start else { continue };
+            let (jz, v) = obj.tail_value(&head, (&at_j, j), &start)?;
+            if v <= most && jz < best.map_or(self.work.j, |(_, b)| b) {
+                best = Some((start, jz));
+            }
+        }
+        Ok(best.map(|(start, _)| start))
     }
 }
 
@@ -156,6 +170,10 @@ enum Next<const K: usize> {
     /// preferred depth first clears its target (`free` feasible), or
     /// `(held, held)` where the climb saturates first.
     Deep((f32, f32)),
+    /// A freed start, where the same lift also clears track `g` at its
+    /// preferred depth: its least altitude there is set by the earlier
+    /// track (a saturated dive's plateau), not by its own depth.
+    Both([f32; K], (f32, f32)),
     Nothing,
 }
 
@@ -178,8 +196,14 @@ impl<const N: usize> Lift<N> {
             z = with_depth(&z, g, self.zg);
             let freed = obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band;
             if freed >= 0.0 {
-                z = with_depth(&z, g, self.zg + freed);
-                return Ok(Next::Freed(z));
+                let start = with_depth(&z, g, self.zg + freed);
+                if let Some(p) = self.deep.filter(|&p| p > self.zg + freed) {
+                    z = with_depth(&z, g, p);
+                    if obj.least_at((&self.at_j, j), &z, g)? >= self.target {
+                        return Ok(Next::Both(start, (held, self.zj - up)));
+                    }
+                }
+                return Ok(Next::Freed(start));
             }
             if let Some(p) = self.deep {
                 z = with_depth(&z, g, p);
