@@ -50,6 +50,22 @@ fn a_low_authority_vehicle_starts_again_wider() {
     horizon_within("low_authority", 1.10, 4.169_39e7);
 }
 
+/// A later track held at its target by an earlier depth while its own
+/// depth sits on a plateau (`check_planner.py --seed 1205 --vehicle
+/// tools/reference/vehicles/stiff.toml`, `unseen_1205_7`): the cold SQP
+/// ended with track 4 in a saturated dive at 2 200 m, where neither `J`
+/// nor track 4's least altitude depends on `z_4`, and that least altitude
+/// at its target, set by track 3's depth (662 m). The linearization sees
+/// no trade between the two, and the plateau scan of `z_4` alone finds no
+/// lower `J`: the line's `J` 3.4331e6 m³, 1.54× the f64 beam search's best
+/// safe plan (2.2318e6 m³: 736.9, 507.3, 718.9, 860.6 m). Restarted from
+/// the plateau's edge (`plan/jump.rs`, `held_edge`): 1.0005×. The
+/// checker's bound is 1.10×.
+#[test]
+fn a_track_held_from_a_plateau_is_freed_at_its_edge() {
+    horizon_within("held_plateau", 1.01, 2.231_8e6);
+}
+
 /// A row beyond the QP's band, crossed unseen (`check_planner.py --seed
 /// 1103 --vehicle tools/reference/vehicles/integ.toml`, `unseen_1103_3`):
 /// track 1's least altitude stays 78.9 m for every depth up to 346 m and

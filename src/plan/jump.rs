@@ -13,6 +13,10 @@
 //! passes from a point within the band to one beyond it whose `J` is
 //! lower, the pair is bisected [`EDGE`] times (one flight of the tail
 //! each) for the feasible point nearest the cliff.
+//!
+//! Where the scan finds no lower point and track `j` is held at its
+//! target by the depths before it, the restart starts just off the
+//! plateau's edge instead ([`Planner::held_edge`]'s docs).
 
 use crate::optim::Bounds;
 use crate::sim::{TrackScore, VehicleState};
@@ -25,6 +29,10 @@ use super::solve::{RESTORE_SHARE, lex_less};
 /// Bisections of a scan's step from a point within the band to one
 /// beyond it with a lower `J`.
 const EDGE: u32 = 3;
+
+/// A scanned point's `J` within this share of the optimum's is on its
+/// plateau.
+const FLAT: f32 = 1e-5;
 
 /// A scanned point: `(z_j, Σ J, v)`, m, m³, m.
 type Point = (f32, f32, f32);
@@ -92,6 +100,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         };
         let flown = (&head, &at_j, j);
+        // The scan's step off the optimum's plateau: (on it, off it).
+        let mut held: Option<(Point, Point)> = None;
         let mut prev: Option<Point> = None;
         // The scan's step into a lower `J` beyond the band (from within
         // it) whose far side is lowest: (within, beyond).
@@ -104,6 +114,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             keep(p, with_depth(&out.z, j, p.0));
             if let Some(q) = prev.filter(|_| !restoring) {
                 edge = lower_edge(edge, (q, p), band);
+                held = off_plateau(held, (q, p), (out.j, v_now + tol), band);
             }
             prev = Some(p);
         }
@@ -120,7 +131,49 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 }
             }
         }
-        best
+        best.or_else(|| self.held_edge(obj, flown, held?, (&out.z, tol)))
+    }
+
+    /// A plateau of `z_j` on which track `j` is held at its target by the
+    /// depths before it (its least altitude at the target, none of it
+    /// `z_j`'s): the start at the plateau's edge. Nowhere on the plateau
+    /// does the linearization see `z_j`, so no step trades it against an
+    /// earlier depth; just off the edge it does. On a random canyon line
+    /// on the `stiff` vehicle (`check_planner.py --seed 1205`,
+    /// `unseen_1205_7`) track 4 dived saturated at 2 200 m, held at its
+    /// target by track 3's depth (662 m); the best safe plan flies track 3
+    /// at 719 m and track 4 at 861 m, out of the saturation. The step
+    /// `(on, off)` of the scan is bisected [`EDGE`] times (one flight of
+    /// the tail each), and the point off the plateau (within the band)
+    /// returned, with its `J` as its score: the restart is kept only if it
+    /// ends lower. `None` when track `j` is not held.
+    fn held_edge(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        flown: (&[TrackScore; K], &VehicleState<N>, usize),
+        (mut on, mut off): (Point, Point),
+        (z, tol): (&[f32; K], f32),
+    ) -> Option<Jump<K>> {
+        let (_, at_j, j) = flown;
+        let m = obj.sc.mission();
+        let band = m.reference_altitude() - m.min_altitude();
+        let slack = tol.max(0.01 * band);
+        let least = obj.least_at((at_j, j), z, j).ok()?;
+        if least > obj.target_of(j) + slack {
+            return None;
+        }
+        let flat_j = on.1;
+        for _ in 0..EDGE {
+            let p = at_depth(obj, flown, 0.5 * (on.0 + off.0), z)?;
+            if flat(p, (flat_j, on.2 + tol)) {
+                on = p;
+            } else if p.2 <= band {
+                off = p;
+            } else {
+                break;
+            }
+        }
+        Some(((0.0, off.1), with_depth(z, j, off.0)))
     }
 }
 
@@ -136,6 +189,30 @@ fn at_depth<const K: usize, const N: usize>(
         .tail_value(head, (at_j, j), &with_depth(z, j, zj))
         .ok()?;
     Some((zj, jz, v))
+}
+
+/// Whether point `p` is on the plateau of `J` `j` (m³): its `J` within
+/// [`FLAT`] of it, its shortfall at most `v` (m).
+fn flat(p: Point, (j, v): (f32, f32)) -> bool {
+    libm::fabsf(p.1 - j) <= FLAT * j && p.2 <= v
+}
+
+/// `held`, or the step `(a, b)` between neighbouring scanned points if it
+/// leaves the plateau `plateau` ([`flat`]) to a point within `band` (m of
+/// shortfall) whose `J` is lower than `held`'s off side: `(on, off)`.
+fn off_plateau(
+    held: Option<(Point, Point)>,
+    (a, b): (Point, Point),
+    plateau: (f32, f32),
+    band: f32,
+) -> Option<(Point, Point)> {
+    let (on, off) = match (flat(a, plateau), flat(b, plateau)) {
+        (true, false) => (a, b),
+        (false, true) => (b, a),
+        _ => return held,
+    };
+    let lower = off.2 <= band && held.is_none_or(|(_, e)| off.1 < e.1);
+    if lower { Some((on, off)) } else { held }
 }
 
 /// `edge`, or the step `(a, b)` between neighbouring scanned points if one
