@@ -66,6 +66,22 @@ fn a_track_held_from_a_plateau_is_freed_at_its_edge() {
     horizon_within("held_plateau", 1.01, 2.231_8e6);
 }
 
+/// A lift whose freed altitude buys far more than its own metres of depth
+/// (`check_planner.py --seed 1206 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_1206_6`): lifted 48 m,
+/// track 2 freed track 3's least altitude by 1.6 m beyond the band, and
+/// the lift deepened track 3 by those 1.6 m; but that least altitude is a
+/// rise passed early in track 3 and falls far slower than a metre per
+/// metre, and the start was worse than the SQP's end. The line's `J`
+/// 2.2076e7 m³, 1.40× the f64 beam search's best safe plan (1.5732e7 m³:
+/// 214.8, 139.9, 285.2, 177.5 m). Now the lift also bisects for the
+/// deepest track 3 that clears its target (`plan/lift.rs`): 1.0007×. The
+/// checker's bound is 1.10×.
+#[test]
+fn a_lift_deepens_the_later_track_as_far_as_it_clears() {
+    horizon_within("lift_slow_fall", 1.01, 1.573_2e7);
+}
+
 /// A row beyond the QP's band, crossed unseen (`check_planner.py --seed
 /// 1103 --vehicle tools/reference/vehicles/integ.toml`, `unseen_1103_3`):
 /// track 1's least altitude stays 78.9 m for every depth up to 346 m and

@@ -20,7 +20,9 @@
 //! saturated dive's plateau), the least lift that frees that depth is
 //! narrowed too, and the start with the lower horizon `J` is taken
 //! (`unseen_1302_5`: 1.40× → 1.001×; the freed start there was worse than
-//! the SQP's end). Where it does not, and track `g` is held more than the band
+//! the SQP's end); where the preferred depth does not clear it, the
+//! deepest depth `g` between the two that does is bisected for, a third
+//! start (`unseen_1206_6`: 1.40× → 1.0007×). Where it does not, and track `g` is held more than the band
 //! above its preferred depth (its bottom's mean less `h_r`), the lift that
 //! lets track `g` fly its preferred depth is sought instead: a dive from
 //! a shallower start passes a rise of the bottom higher, so a climb on
@@ -123,15 +125,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // (A freed start is kept within the band of feasible, as the SQP
         // left it; a start at the preferred depth may be far from it, the
         // climb saturated, and the restart's first steps close that.)
-        let (freed, deep) = match l.search(obj, z)? {
-            Next::Freed(start) => (Some(start), None),
-            Next::Deep(lifts) => (None, Some(l.narrowed(obj, z, lifts)?)),
-            Next::Both(start, lifts) => (Some(start), Some(l.narrowed(obj, z, lifts)?)),
+        let (freed, deeper, deep) = match l.search(obj, z)? {
+            Next::Freed(start, deeper) => (Some(start), deeper, None),
+            Next::Deep(lifts) => (None, None, Some(l.narrowed(obj, z, lifts)?)),
+            Next::Both(start, lifts) => (Some(start), None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Nothing => return Ok(None),
         };
         // The start whose horizon `J` is lowest, below the SQP's.
         let mut best: Option<([f32; K], f32)> = None;
-        for (start, most) in [(freed, band), (deep, f32::INFINITY)] {
+        for (start, most) in [(freed, band), (deeper, band), (deep, f32::INFINITY)] {
             let Some(start) = start else { continue };
             let (jz, v) = obj.tail_value(&head, (&at_j, j), &start)?;
             if v <= most && jz < best.map_or(self.work.j, |(_, b)| b) {
@@ -164,8 +166,12 @@ struct Lift<const N: usize> {
 
 /// What the lifts by doubling found.
 enum Next<const K: usize> {
-    /// A start with track `g` deepened by the altitude freed.
-    Freed([f32; K]),
+    /// A start with track `g` deepened by the altitude freed; and, where
+    /// track `g` at its preferred depth does not clear its target at that
+    /// lift, the start with the deepest depth `g` found that does (its
+    /// least altitude may fall far slower than a metre per metre: a rise
+    /// passed early in the track, before the dive).
+    Freed([f32; K], Option<[f32; K]>),
     /// The lifts `(held, free)` (m) between which track `g` at its
     /// preferred depth first clears its target (`free` feasible), or
     /// `(held, held)` where the climb saturates first.
@@ -197,13 +203,15 @@ impl<const N: usize> Lift<N> {
             let freed = obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band;
             if freed >= 0.0 {
                 let start = with_depth(&z, g, self.zg + freed);
-                if let Some(p) = self.deep.filter(|&p| p > self.zg + freed) {
-                    z = with_depth(&z, g, p);
-                    if obj.least_at((&self.at_j, j), &z, g)? >= self.target {
-                        return Ok(Next::Both(start, (held, self.zj - up)));
-                    }
+                let Some(p) = self.deep.filter(|&p| p > self.zg + freed) else {
+                    return Ok(Next::Freed(start, None));
+                };
+                z = with_depth(&z, g, p);
+                if obj.least_at((&self.at_j, j), &z, g)? >= self.target {
+                    return Ok(Next::Both(start, (held, self.zj - up)));
                 }
-                return Ok(Next::Freed(start));
+                let deeper = self.deepest(obj, z, (self.zg + freed, p))?;
+                return Ok(Next::Freed(start, Some(deeper)));
             }
             if let Some(p) = self.deep {
                 z = with_depth(&z, g, p);
@@ -224,6 +232,28 @@ impl<const N: usize> Lift<N> {
             lift *= 2.0;
         }
         Ok(Next::Nothing)
+    }
+
+    /// `z` with depth `g` the deepest in `[clear, held]` (m) at which track
+    /// `g` clears its target, by [`NARROW`] bisections (one flight of the
+    /// two tracks each).
+    fn deepest<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        (mut clear, mut held): (f32, f32),
+    ) -> Result<[f32; K], Stop> {
+        for _ in 0..NARROW {
+            let mid = 0.5 * (clear + held);
+            if obj.least_at((&self.at_j, self.j), &with_depth(&z, self.g, mid), self.g)?
+                >= self.target
+            {
+                clear = mid;
+            } else {
+                held = mid;
+            }
+        }
+        Ok(with_depth(&z, self.g, clear))
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
