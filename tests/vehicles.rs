@@ -82,6 +82,21 @@ fn a_lift_deepens_the_later_track_as_far_as_it_clears() {
     horizon_within("lift_slow_fall", 1.01, 1.573_2e7);
 }
 
+/// A plateau left for the third round of the escape (`check_planner.py
+/// --seed 1403 --vehicle tools/reference/vehicles/integ.toml`,
+/// `unseen_1403_5`): the cold SQP started 85 m short and stopped
+/// infeasible with four depths on plateaus; the escape's first round
+/// jumped track 2 (feasibility), its second track 3 (a lower `J`), and
+/// track 1 stayed on its saturated climb's plateau at 546 m, where the
+/// best safe plan flies 646 m: the line's `J` 2.7529e6 m³, 1.72× the f64
+/// beam search's best (1.6048e6 m³: 646.4, 799.0, 570.6, 430.6, 220.0 m).
+/// With a third round (`plan/solve.rs`): 1.007×. The checker's bound is
+/// 1.10×.
+#[test]
+fn a_third_plateau_round_frees_a_depth_the_first_two_left() {
+    horizon_within("third_plateau", 1.01, 1.604_8e6);
+}
+
 /// A row beyond the QP's band, crossed unseen (`check_planner.py --seed
 /// 1103 --vehicle tools/reference/vehicles/integ.toml`, `unseen_1103_3`):
 /// track 1's least altitude stays 78.9 m for every depth up to 346 m and
