@@ -97,6 +97,21 @@ fn a_third_plateau_round_frees_a_depth_the_first_two_left() {
     horizon_within("third_plateau", 1.01, 1.604_8e6);
 }
 
+/// A later track held while the plateau's own track is not
+/// (`check_planner.py --seed 1106 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_1106_6`): the cold SQP
+/// ended with track 3's depth on a plateau (653 m: neither `J` nor any
+/// least altitude depends on it) and track 4 held at its target by track
+/// 2's depth (173 m). The line's `J` 7.1394e6 m³, 1.24× the f64 beam
+/// search's best safe plan (5.7627e6 m³: 255.8, 219.3, 597.8, 959.5 m).
+/// The cold call's last escape restarts from track 3's plateau edge,
+/// where track 4 is freed (`plan/jump.rs`, `held_last`): 1.0005×. The
+/// checker's bound is 1.10×.
+#[test]
+fn a_later_track_held_past_a_plateau_is_freed_last() {
+    horizon_within("held_later", 1.01, 5.762_7e6);
+}
+
 /// A row beyond the QP's band, crossed unseen (`check_planner.py --seed
 /// 1103 --vehicle tools/reference/vehicles/integ.toml`, `unseen_1103_3`):
 /// track 1's least altitude stays 78.9 m for every depth up to 346 m and

@@ -262,6 +262,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // +27 %, the line over its 800 M instructions: BENCHMARKS.md.)
             if !declared {
                 iterations = self.lift_earlier(&mut obj, (h, &s.bounds), tol, iterations);
+                iterations = self.held_last(&mut obj, (h, &s.bounds), tol, iterations);
             }
         }
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);

@@ -34,6 +34,9 @@ const EDGE: u32 = 3;
 /// plateau.
 const FLAT: f32 = 1e-5;
 
+/// A merit weight (m³/m) that prices any shortfall out of a scan.
+const PRICED_OUT: f32 = 1e30;
+
 /// A scanned point: `(z_j, Σ J, v)`, m, m³, m.
 type Point = (f32, f32, f32);
 
@@ -60,7 +63,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         obj: &mut PlanObjective<'_, N>,
         bounds: &Bounds<K>,
         j: usize,
-        (tol, rho): (f32, f32),
+        (tol, rho, later): (f32, f32, bool),
     ) -> Option<Jump<K>> {
         let (&lo, &hi) = bounds.lo.get(j).zip(bounds.hi.get(j))?;
         let out = &self.work;
@@ -131,7 +134,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 }
             }
         }
-        best.or_else(|| self.held_edge(obj, flown, held?, (&out.z, tol)))
+        best.or_else(|| self.held_edge(obj, flown, held?, (&out.z, tol, later)))
     }
 
     /// A plateau of `z_j` on which track `j` is held at its target by the
@@ -152,14 +155,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         obj: &mut PlanObjective<'_, N>,
         flown: (&[TrackScore; K], &VehicleState<N>, usize),
         (mut on, mut off): (Point, Point),
-        (z, tol): (&[f32; K], f32),
+        (z, tol, later): (&[f32; K], f32, bool),
     ) -> Option<Jump<K>> {
         let (_, at_j, j) = flown;
         let m = obj.sc.mission();
         let band = m.reference_altitude() - m.min_altitude();
         let slack = tol.max(0.01 * band);
-        let least = obj.least_at((at_j, j), z, j).ok()?;
-        if least > obj.target_of(j) + slack {
+        let (g, least) = obj.held_from((at_j, j), z, slack).ok()??;
+        if g != j && !later {
             return None;
         }
         let flat_j = on.1;
@@ -173,7 +176,48 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 break;
             }
         }
-        Some(((0.0, off.1), with_depth(z, j, off.0)))
+        let start = with_depth(z, j, off.0);
+        // A later track held must be freed off the plateau: else the
+        // linearization there sees no trade either.
+        let freed = g == j || obj.least_at((at_j, j), &start, g).ok()? > least + slack;
+        freed.then_some(((0.0, off.1), start))
+    }
+
+    /// A cold horizon's last escape: [`Planner::held_edge`] for a track
+    /// held after the plateau's own (`later`), from the best of every
+    /// plateau's scan, the SQP restarted there and kept if it ends lower.
+    /// Last, because a kept restart moves the point from which the other
+    /// escapes start (`unseen_1404_5`: the lift found a lower `J` from
+    /// where the plateau rounds left it, and none from the held edge's).
+    /// On `unseen_1106_6` (`low`), track 3's depth on its plateau and
+    /// track 4 held by track 2's: 1.24× → 1.0005×. Returns the iterations
+    /// so far.
+    #[inline(never)]
+    pub(super) fn held_last(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        iterations: u32,
+    ) -> u32 {
+        if obj.last_violation > tol || iterations >= self.cfg.bfgs.max_iterations {
+            return iterations;
+        }
+        let mut best: Option<Jump<K>> = None;
+        for j in 0..h {
+            // (Shortfall priced out: the rounds took the plateaus' lower
+            // points already; this pass is for the held edges.)
+            if let Some(c) = self.sqp_plateau_jump(obj, bounds, j, (tol, PRICED_OUT, true))
+                && best.as_ref().is_none_or(|b| lex_less(c.0, b.0))
+            {
+                best = Some(c);
+            }
+        }
+        let Some((_, z)) = best else {
+            return iterations;
+        };
+        self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
+            .unwrap_or(iterations)
     }
 }
 

@@ -230,6 +230,33 @@ impl<const N: usize> PlanObjective<'_, N> {
         Ok(last.min_altitude())
     }
 
+    /// Tracks `j..` of the horizon flown at `z` from `at_j`, the state
+    /// track `j` starts in: the first of them whose least altitude is
+    /// within `slack` (m) of its target, with that altitude (m). One
+    /// flight, counted.
+    pub fn held_from<const K: usize>(
+        &mut self,
+        (at_j, j): (&VehicleState<N>, usize),
+        z: &[f32; K],
+        slack: f32,
+    ) -> Result<Option<(usize, f32)>, Stop> {
+        self.count_flight()?;
+        let used = z
+            .get(j..self.count)
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        let mut scores = [TrackScore::default(); K];
+        let flown = scores
+            .get_mut(..used.len())
+            .ok_or(Stop::Sim(SimError::TrackRange))?;
+        self.sc
+            .fly(at_j, self.track.saturating_add(j), used, flown)
+            .map_err(Stop::Sim)?;
+        Ok(flown.iter().enumerate().find_map(|(i, s)| {
+            let g = j.saturating_add(i);
+            (s.min_altitude() <= self.target_of(g) + slack).then_some((g, s.min_altitude()))
+        }))
+    }
+
     /// `(Σ J, v)` of the horizon's `scores` (m³, m): a non-finite `J` is
     /// a diverged flight.
     fn value_of(&self, scores: &[TrackScore]) -> Result<(f32, f32), Stop> {

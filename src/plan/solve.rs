@@ -198,7 +198,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 if self.work.gradient.get(j).is_some_and(|&g| g == 0.0) {
                     scanned |= bit;
                 }
-                if let Some(c) = self.sqp_plateau_jump(obj, bounds, j, (tol, rho))
+                if let Some(c) = self.sqp_plateau_jump(obj, bounds, j, (tol, rho, false))
                     && best.as_ref().is_none_or(|b| lex_less(c.0, b.0))
                 {
                     best = Some((c.0, c.1, bit));
