@@ -101,8 +101,8 @@ const STALLS: u32 = 5;
 /// Gauss–Newton matrix at `z0`; the final metric on return. `rho0`: the
 /// merit weight to start from (m³/m; 0 learns it from the multipliers).
 /// `careful`: the QP also takes the rows beyond the band its step would
-/// cross (module docs). A run that ends infeasible or worse than its best feasible iterate
-/// goes back to that iterate (`best.rs`). Returns the
+/// cross (module docs). A run that ends infeasible or worse than its best
+/// feasible iterate goes back to that iterate (`best.rs`). Returns the
 /// ℓ1 merit's final penalty weight and any row active at a one-sided kink
 /// at the end ([`SqpEnd`]).
 ///

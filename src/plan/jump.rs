@@ -160,7 +160,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let (_, at_j, j) = flown;
         let m = obj.sc.mission();
         let band = m.reference_altitude() - m.min_altitude();
-        let slack = tol.max(0.01 * band);
+        let slack = obj.held_slack(tol);
         let (g, least) = obj.held_from((at_j, j), z, slack).ok()??;
         if g != j && !later {
             return None;

@@ -22,7 +22,8 @@
 //! (`unseen_1302_5`: 1.40× → 1.001×; the freed start there was worse than
 //! the SQP's end); where the preferred depth does not clear it, the
 //! deepest depth `g` between the two that does is bisected for, a third
-//! start (`unseen_1206_6`: 1.40× → 1.0007×). Where it does not, and track `g` is held more than the band
+//! start (`unseen_1206_6`: 1.40× → 1.0007×). Where no lift frees track
+//! `g` by the band, and track `g` is held more than the band
 //! above its preferred depth (its bottom's mean less `h_r`), the lift that
 //! lets track `g` fly its preferred depth is sought instead: a dive from
 //! a shallower start passes a rise of the bottom higher, so a climb on
@@ -93,7 +94,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<Option<[f32; K]>, Stop> {
         let h_r = obj.sc.mission().reference_altitude();
         let band = h_r - obj.sc.mission().min_altitude();
-        let slack = tol.max(0.01 * band);
+        let slack = obj.held_slack(tol);
         let j = g.saturating_sub(1);
         let z = self.work.z;
         let (head, at_j) = obj.head(&z, j)?;
@@ -235,25 +236,38 @@ impl<const N: usize> Lift<N> {
     }
 
     /// `z` with depth `g` the deepest in `[clear, held]` (m) at which track
-    /// `g` clears its target, by [`NARROW`] bisections (one flight of the
-    /// two tracks each).
+    /// `g` clears its target ([`Lift::clearing`]).
     fn deepest<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         z: [f32; K],
-        (mut clear, mut held): (f32, f32),
+        ends: (f32, f32),
     ) -> Result<[f32; K], Stop> {
+        let d = self.clearing(obj, &z, (self.g, |d| d), ends)?;
+        Ok(with_depth(&z, self.g, d))
+    }
+
+    /// The point of `(clear, held)` nearest `held` at which track `g`
+    /// clears its target, found by [`NARROW`] bisections (one flight of
+    /// the two tracks each), with depth `k` of `z` at `depth(t)` (m) for
+    /// each point `t` tried.
+    fn clearing<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: &[f32; K],
+        (k, depth): (usize, impl Fn(f32) -> f32),
+        (mut clear, mut held): (f32, f32),
+    ) -> Result<f32, Stop> {
         for _ in 0..NARROW {
             let mid = 0.5 * (clear + held);
-            if obj.least_at((&self.at_j, self.j), &with_depth(&z, self.g, mid), self.g)?
-                >= self.target
-            {
+            let at = with_depth(z, k, depth(mid));
+            if obj.least_at((&self.at_j, self.j), &at, self.g)? >= self.target {
                 clear = mid;
             } else {
                 held = mid;
             }
         }
-        Ok(with_depth(&z, self.g, clear))
+        Ok(clear)
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
@@ -262,24 +276,14 @@ impl<const N: usize> Lift<N> {
     fn narrowed<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
-        mut z: [f32; K],
-        (mut held, mut free): (f32, f32),
+        z: [f32; K],
+        (held, mut free): (f32, f32),
     ) -> Result<[f32; K], Stop> {
-        let p = self.deep.unwrap_or(self.zg);
-        z = with_depth(&z, self.g, p);
+        let z = with_depth(&z, self.g, self.deep.unwrap_or(self.zg));
         if free > held {
-            for _ in 0..NARROW {
-                let mid = 0.5 * (held + free);
-                z = with_depth(&z, self.j, self.zj - mid);
-                if obj.least_at((&self.at_j, self.j), &z, self.g)? >= self.target {
-                    free = mid;
-                } else {
-                    held = mid;
-                }
-            }
+            free = self.clearing(obj, &z, (self.j, |lift| self.zj - lift), (free, held))?;
         }
-        z = with_depth(&z, self.j, self.zj - free);
-        Ok(z)
+        Ok(with_depth(&z, self.j, self.zj - free))
     }
 }
 

@@ -199,12 +199,7 @@ impl<const N: usize> PlanObjective<'_, N> {
         j: usize,
         zj: f32,
     ) -> Result<f32, Stop> {
-        self.count_flight()?;
-        let mut score = [TrackScore::default()];
-        self.sc
-            .fly(at_j, self.track.saturating_add(j), &[zj], &mut score)
-            .map_err(Stop::Sim)?;
-        let [flown] = score;
+        let [flown] = self.fly_from::<1>((at_j, j), &[zj])?;
         Ok(flown.min_altitude())
     }
 
@@ -217,16 +212,11 @@ impl<const N: usize> PlanObjective<'_, N> {
         z: &[f32; K],
         g: usize,
     ) -> Result<f32, Stop> {
-        self.count_flight()?;
         let used = z.get(j..=g).ok_or(Stop::Sim(SimError::TrackRange))?;
-        let mut scores = [TrackScore::default(); K];
-        let flown = scores
-            .get_mut(..used.len())
+        let flown = self.fly_from::<K>((at_j, j), used)?;
+        let last = flown
+            .get(g.saturating_sub(j))
             .ok_or(Stop::Sim(SimError::TrackRange))?;
-        self.sc
-            .fly(at_j, self.track.saturating_add(j), used, flown)
-            .map_err(Stop::Sim)?;
-        let last = flown.last().ok_or(Stop::Sim(SimError::TrackRange))?;
         Ok(last.min_altitude())
     }
 
@@ -240,21 +230,45 @@ impl<const N: usize> PlanObjective<'_, N> {
         z: &[f32; K],
         slack: f32,
     ) -> Result<Option<(usize, f32)>, Stop> {
-        self.count_flight()?;
         let used = z
             .get(j..self.count)
             .ok_or(Stop::Sim(SimError::TrackRange))?;
-        let mut scores = [TrackScore::default(); K];
+        let flown = self.fly_from::<K>((at_j, j), used)?;
+        Ok(flown
+            .iter()
+            .take(used.len())
+            .enumerate()
+            .find_map(|(i, s)| {
+                let g = j.saturating_add(i);
+                (s.min_altitude() <= self.target_of(g) + slack).then_some((g, s.min_altitude()))
+            }))
+    }
+
+    /// How far above its target (m) a track's least altitude still counts
+    /// as held there: a hundredth of the band `h_r − h_a`, or the
+    /// feasibility tolerance `tol` (m) if larger.
+    pub fn held_slack(&self, tol: f32) -> f32 {
+        let m = self.sc.mission();
+        tol.max(0.01 * (m.reference_altitude() - m.min_altitude()))
+    }
+
+    /// Tracks `j..j + used.len()` of the horizon flown at the depths
+    /// `used` (m) from `at_j`, the state track `j` starts in: their scores,
+    /// the first `used.len()` of the `L`. One flight, counted.
+    fn fly_from<const L: usize>(
+        &mut self,
+        (at_j, j): (&VehicleState<N>, usize),
+        used: &[f32],
+    ) -> Result<[TrackScore; L], Stop> {
+        self.count_flight()?;
+        let mut scores = [TrackScore::default(); L];
         let flown = scores
             .get_mut(..used.len())
             .ok_or(Stop::Sim(SimError::TrackRange))?;
         self.sc
             .fly(at_j, self.track.saturating_add(j), used, flown)
             .map_err(Stop::Sim)?;
-        Ok(flown.iter().enumerate().find_map(|(i, s)| {
-            let g = j.saturating_add(i);
-            (s.min_altitude() <= self.target_of(g) + slack).then_some((g, s.min_altitude()))
-        }))
+        Ok(scores)
     }
 
     /// `(Σ J, v)` of the horizon's `scores` (m³, m): a non-finite `J` is
