@@ -8,7 +8,8 @@
 # example qemu_panic_never (the planner and a minimal runtime): it builds
 # that example for the same target first (`cargo build --release`, and once
 # more at opt-level "s" with fat LTO into target/qemu-size-lto), then reads
-# section sizes with binutils' `size` and checks for an allocator with `nm`.
+# section sizes with binutils' `size`, checks for an allocator with `nm`
+# and bounds a plan call's stack over every path (stack_bound.py).
 #
 # Also writes the rows as tab-separated values to
 # target/qemu-bench/<machine>.tsv, which scripts/qemu-bench.sh merges into
@@ -53,13 +54,15 @@ if [ "$triple" = thumbv7em-none-eabihf ]; then # the size-optimized build: M4F o
   read -r l_text l_ro _ _ _ <<<"$(app_sizes "$target_dir/qemu-size-lto/$triple/release/examples/qemu_panic_never")"
 fi
 alloc="$(has_alloc "$app")/$(has_alloc "$elf")"
+# The static bound of a plan call's stack, every path (tools/qemu/stack_bound.py).
+bound=$(python3 "$here/stack_bound.py" "$app" | sed -n 's/^stack-bound|//p')
 
 mkdir -p "$target_dir/qemu-bench"
 tsv=$target_dir/qemu-bench/$machine.tsv
 
 awk -v machine_line="$machine_line" -v tsv="$tsv" \
   -v a_text="$a_text" -v a_ro="$a_ro" -v a_ram="$((a_data + a_bss + a_un))" \
-  -v l_text="$l_text" -v l_ro="$l_ro" -v alloc="$alloc" -F'|' '
+  -v l_text="$l_text" -v l_ro="$l_ro" -v alloc="$alloc" -v bound="${bound:-0}" -F'|' '
 function group(n,   s, neg) {   # 1234567 -> 1 234 567
   n = sprintf("%.0f", n); neg = (n ~ /^-/); if (neg) n = substr(n, 2)
   s = ""
@@ -137,6 +140,7 @@ END {
   printf "| track-wise solve of the steepest track (%s, %.1f deg) | %s | <= 10 000 000 |\n", "track " substr(steep, 4), steep_deg, group(count[steep] - over)
   printf "| stack high-water mark of one solve, track-wise (Planner::<1>), worst track | %s | <= 8 KiB |\n", kib(tw_stack)
   printf "| stack high-water mark of one solve, horizon (Planner::<5>), worst call | %s | <= 8 KiB |\n", hz_stack ? kib(hz_stack) : "not run"
+  printf "| stack of any plan call (Planner::<5>), static bound over every path (tools/qemu/stack_bound.py) | %s | <= 8 KiB |\n", (bound > 0 ? kib(bound) : "not a bound")
   if (hz_sum > 0) {
     printf "| horizon (Planner::<5>), cold call (track 1) | %s | <= 250 000 000 |\n", group(hz_cold)
     printf "| horizon (Planner::<5>), worst later call | %s | <= 40 000 000 |\n", group(hz_later)
@@ -153,5 +157,5 @@ END {
   print ""
   printf "Planner application: examples/qemu_panic_never.rs (Planner::<5>, the line'"'"'s data, cortex-m-rt, semihosting exit; vector table apart), .text %s B + .rodata %s B.\n", group(a_text), group(a_ro)
   printf "Benchmark image: .text %s B, .rodata %s B, vector table %s B, .data + .bss %s B.\n", group(img_text), group(img_ro), group(img_vec), group(img_ram)
-  printf "step\t%.1f\nsteep\t%s\ntw_stack\t%d\nhz_stack\t%d\nflash\t%d\nflash_lto\t%d\nram\t%d\n", step, steep, tw_stack, hz_stack, a_text + a_ro, l_text + l_ro, a_ram >> tsv
+  printf "step\t%.1f\nsteep\t%s\ntw_stack\t%d\nhz_stack\t%d\nstack_bound\t%d\nflash\t%d\nflash_lto\t%d\nram\t%d\n", step, steep, tw_stack, hz_stack, bound, a_text + a_ro, l_text + l_ro, a_ram >> tsv
 }' <<<"$input"
