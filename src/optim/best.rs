@@ -44,14 +44,15 @@ impl<const K: usize> BestFeasible<K> {
             return false;
         }
         crate::log::debug!("sqp: back to the best feasible iterate, J {=f32} m3", j);
-        let mut back = Linearized::default();
-        if obj.linearize(&z, false, &mut back).is_ok() {
+        // Into `lin` itself, not a copy (a linearization is about 1 KB of
+        // stack at K = 5): a failed one is the flight budget's, which stops
+        // before writing anything, and `z` was linearized before.
+        if obj.linearize(&z, false, lin).is_ok() {
             *z_end = z;
-            *lin = back;
             return true;
         }
         // (The objective's own state back at the run's end.)
-        let _ = obj.linearize(z_end, false, &mut back);
+        let _ = obj.linearize(z_end, false, lin);
         false
     }
 }

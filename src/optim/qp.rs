@@ -79,6 +79,15 @@ pub(crate) struct QpSolution<const K: usize> {
     pub lambda: Vec<f32, QP_ROWS>,
 }
 
+impl<const K: usize> Default for QpSolution<K> {
+    fn default() -> Self {
+        Self {
+            d: [0.0; K],
+            lambda: Vec::new(),
+        }
+    }
+}
+
 /// The working state of the dual method.
 struct Work<const K: usize> {
     /// Variables used.
@@ -122,8 +131,10 @@ fn reflect_columns<const K: usize>(m: &mut Mat<K>, n: usize, p: usize, (c, s): (
     }
 }
 
-/// Solves the problem of the module docs. `g_mat` and `g` beyond `n` are
-/// ignored, as are the rows' entries beyond `n`.
+/// Solves the problem of the module docs into `out` (written only on
+/// success; in place, not returned: a solution is 284 B at K = 5, and
+/// each copy of it was stack). `g_mat` and `g` beyond `n` are ignored, as
+/// are the rows' entries beyond `n`.
 ///
 /// # Errors
 /// [`QpError`]: `G` not definite, rows incompatible, or the cap reached.
@@ -132,7 +143,8 @@ pub(crate) fn solve<const K: usize, R: Rows<K> + ?Sized>(
     g: &[f32; K],
     n: usize,
     rows: &R,
-) -> Result<QpSolution<K>, QpError> {
+    out: &mut QpSolution<K>,
+) -> Result<(), QpError> {
     let n = n.min(K);
     let m = rows.count().min(QP_ROWS);
     // Each row `i` is used as `(aᵢ, cᵢ) · scale[i]`: a unit gradient over
@@ -171,7 +183,8 @@ pub(crate) fn solve<const K: usize, R: Rows<K> + ?Sized>(
             }
         }
         let Some((p, _)) = worst else {
-            return Ok(w.solution(m, &scale));
+            w.solution(m, &scale, out);
+            return Ok(());
         };
         let Some((np, cp)) = unit(p) else {
             return Err(QpError::Incompatible);
@@ -374,18 +387,18 @@ impl<const K: usize> Work<K> {
         }
     }
 
-    /// The step and the multipliers in the rows' own units.
-    fn solution(&self, m: usize, scale: &[f32; QP_ROWS]) -> QpSolution<K> {
-        let mut lambda: Vec<f32, QP_ROWS> = Vec::new();
+    /// The step and the multipliers in the rows' own units, into `out`.
+    fn solution(&self, m: usize, scale: &[f32; QP_ROWS], out: &mut QpSolution<K>) {
+        out.d = self.x;
+        out.lambda.clear();
         for _ in 0..m {
-            let _ = lambda.push(0.0);
+            let _ = out.lambda.push(0.0);
         }
         for (&i, &u) in self.active.iter().zip(self.u.iter()) {
-            if let (Some(l), Some(&s)) = (lambda.get_mut(i), scale.get(i)) {
+            if let (Some(l), Some(&s)) = (out.lambda.get_mut(i), scale.get(i)) {
                 *l = u * s;
             }
         }
-        QpSolution { d: self.x, lambda }
     }
 }
 
@@ -393,6 +406,17 @@ impl<const K: usize> Work<K> {
 #[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
+
+    /// [`solve`], its solution returned.
+    fn solve<const K: usize>(
+        g_mat: &Mat<K>,
+        g: &[f32; K],
+        n: usize,
+        rows: &[Row<K>],
+    ) -> Result<QpSolution<K>, QpError> {
+        let mut out = QpSolution::default();
+        super::solve(g_mat, g, n, rows, &mut out).map(|()| out)
+    }
 
     struct Lcg(u64);
     impl Lcg {

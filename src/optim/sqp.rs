@@ -61,7 +61,7 @@ use super::best::BestFeasible;
 use super::constrained::CONSTRAINTS;
 pub(crate) use super::constrained::{Constrained, Linearized};
 use super::dense::{Mat, at, damped_update, dot, mul, put};
-use super::qp;
+use super::qp::{self, QpSolution};
 use super::step::{REGULARIZATION, StepRows, step};
 use super::{BfgsConfig, Bounds, OptimError, Outcome, Status, Vector};
 
@@ -96,9 +96,9 @@ const STALLS: u32 = 5;
 /// the module docs with `cfg`'s iteration cap, tolerances and Armijo
 /// constant; the result is written into `out`, `J` at the start and at
 /// each iterate appended to `out.history` (not monotone: an early iterate
-/// may be infeasible, and lower). `metric`: the first metric when given
-/// (a restart near a finished run keeps its curvature), else the
-/// Gauss–Newton matrix at `z0`; the final metric on return. `rho0`: the
+/// may be infeasible, and lower). The first metric is the Gauss–Newton
+/// matrix at `z0` (a restart's too: the plateau's row of a finished run's
+/// metric is empty, its step there would be unbounded). `rho0`: the
 /// merit weight to start from (m³/m; 0 learns it from the multipliers).
 /// `careful`: the QP also takes the rows beyond the band its step would
 /// cross (module docs). A run that ends infeasible or worse than its best
@@ -110,7 +110,7 @@ const STALLS: u32 = 5;
 /// [`OptimError`] when the objective fails or is not finite at the start.
 pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     obj: &mut O,
-    (z0, metric, rho0, careful): (&[f32; K], &mut Option<Mat<K>>, f32, bool),
+    (z0, rho0, careful): (&[f32; K], f32, bool),
     (bounds, n): (&Bounds<K>, usize),
     cfg: &BfgsConfig,
     feas_tol: f32,
@@ -132,12 +132,12 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         stalls: 0,
         careful,
     };
-    obj.linearize(&run.z, metric.is_none(), &mut run.lin)
+    obj.linearize(&run.z, true, &mut run.lin)
         .map_err(OptimError::Start)?;
     if !(run.lin.j.is_finite() && run.lin.grad.iter().all(|g| g.is_finite())) {
         return Err(OptimError::NonFinite);
     }
-    run.a = initial_metric(metric.as_ref().unwrap_or(&run.lin.gn), n);
+    run.a = initial_metric(&run.lin.gn, n);
     let _ = out.history.push(run.lin.j);
     let mut restorations = 0;
     let mut best = BestFeasible::default();
@@ -179,7 +179,6 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     out.iterations = run.iterations;
     out.evaluations = run.evaluations;
     out.skipped_updates = run.skipped;
-    *metric = Some(run.a);
     Ok(SqpEnd {
         rho: run.rho,
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
@@ -363,19 +362,14 @@ impl<const K: usize> Run<K> {
         obj: &mut O,
         (bounds, n): (&Bounds<K>, usize),
     ) -> bool {
-        let mut unit: Mat<K> = [[0.0; K]; K];
-        for i in 0..n {
-            put(&mut unit, i, i, 1.0);
-        }
-        let rows = StepRows::new(&self.lin, (&self.z, bounds, n), (0.0, self.lin.band));
-        let Ok(sol) = qp::solve(&unit, &[0.0; K], n, &rows) else {
+        let Some(d) = least_step(&self.lin, &self.z, (bounds, n)) else {
             return false;
         };
         let v0 = self.lin.infeasibility;
         let mut alpha = 1.0_f32;
         for _ in 0..4 {
             let trial: [f32; K] = core::array::from_fn(|i| {
-                let (z, d) = (self.z.get(i), sol.d.get(i));
+                let (z, d) = (self.z.get(i), d.get(i));
                 z.copied().unwrap_or(0.0) + alpha * d.copied().unwrap_or(0.0)
             });
             let zt = bounds.project(&trial);
@@ -402,6 +396,25 @@ impl<const K: usize> Run<K> {
         }
         false
     }
+}
+
+/// The restoration's step from `z` (module docs of [`Run::restore`]): the
+/// least step in the Euclidean norm onto `lin`'s rows, unrelaxed, in the
+/// box. Not inlined: its QP stays off the stack of the flights that follow.
+#[inline(never)]
+fn least_step<const K: usize>(
+    lin: &Linearized<K>,
+    z: &[f32; K],
+    (bounds, n): (&Bounds<K>, usize),
+) -> Option<[f32; K]> {
+    let mut unit: Mat<K> = [[0.0; K]; K];
+    for i in 0..n {
+        put(&mut unit, i, i, 1.0);
+    }
+    let rows = StepRows::new(lin, (z, bounds, n), (0.0, lin.band));
+    let mut sol = QpSolution::default();
+    qp::solve(&unit, &[0.0; K], n, &rows, &mut sol).ok()?;
+    Some(sol.d)
 }
 
 /// The first metric: the Gauss–Newton matrix over the first `n`

@@ -8,7 +8,7 @@ use heapless::Vec;
 use super::Bounds;
 use super::constrained::{CONSTRAINTS, Linearized};
 use super::dense::{Mat, at, dot, put};
-use super::qp::{self, QP_ROWS, QpError, Row, Rows};
+use super::qp::{self, QP_ROWS, QpError, QpSolution, Row, Rows};
 
 /// Relaxations of an incompatible QP: the share of each shortfall left.
 const RELAXATIONS: [f32; 4] = [0.0, 0.5, 0.9, 1.0];
@@ -35,11 +35,12 @@ pub(super) fn step<const K: usize>(
     // (One frame for both solves: two calls of a helper that returned
     // the step grew the horizon's stack by 440 B on the M4F.)
     let mut band = lin.band;
+    let mut sol = QpSolution::default();
     'bands: loop {
         for &sigma in &RELAXATIONS {
             let rows = StepRows::new(lin, (z, bounds, n), (sigma, band));
-            match qp::solve(&a_reg, &lin.grad, n, &rows) {
-                Ok(sol) => {
+            match qp::solve(&a_reg, &lin.grad, n, &rows, &mut sol) {
+                Ok(()) => {
                     let longest = sol.d.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)));
                     let mut d = sol.d;
                     if longest > max_step {

@@ -150,10 +150,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         (skip, far): (u64, bool),
     ) -> Result<(u32, u64), PlanError> {
-        let mut metric = None;
         let run = sqp_into(
             obj,
-            (z0, &mut metric, 0.0, false),
+            (z0, 0.0, false),
             (bounds, h),
             &self.cfg.bfgs,
             tol,
@@ -253,12 +252,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                     .max(1),
                 ..self.cfg.bfgs
             };
-            // (A fresh metric: the plateau's row of the finished one is
-            // empty, its step there would be unbounded.)
-            let mut fresh = None;
+            // (A fresh metric, `sqp_into`'s Gauss–Newton one.)
             let restart = sqp_into(
                 obj,
-                (&from, &mut fresh, rho, careful),
+                (&from, rho, careful),
                 (bounds, h),
                 &left,
                 tol,
