@@ -171,13 +171,16 @@ pub(crate) fn max(a: f32, b: f32) -> f32 {
 /// The point `a + t (b − a)` of the segment from `a` to `b` (m), per
 /// entry.
 pub(crate) fn between<const L: usize>(a: &[f32; L], b: &[f32; L], t: f32) -> [f32; L] {
-    core::array::from_fn(|i| {
-        let (ai, bi) = (
-            a.get(i).copied().unwrap_or(0.0),
-            b.get(i).copied().unwrap_or(0.0),
-        );
-        ai + t * (bi - ai)
-    })
+    let mut out = [0.0; L];
+    between_into(a, b, t, &mut out);
+    out
+}
+
+/// [`between`] into `out` (in place: a line's continuation is 256 B).
+pub(crate) fn between_into<const L: usize>(a: &[f32; L], b: &[f32; L], t: f32, out: &mut [f32; L]) {
+    for ((o, &ai), &bi) in out.iter_mut().zip(a).zip(b) {
+        *o = ai + t * (bi - ai);
+    }
 }
 
 /// Degrees to radians, as f32.

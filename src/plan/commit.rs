@@ -74,7 +74,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         sc: &Scenario<'_, N>,
         state: &VehicleState<N>,
         track: usize,
-        cand: Candidate<N>,
+        cand: &Candidate<N>,
     ) -> Result<Plan<N>, PlanError> {
         let bottom = certification_bottom(sc)?;
         let kept = self.tube.prepare_for(sc, state, track);
@@ -87,7 +87,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // needs it (the budget accounts for it at every call).
         let lazy = self.budget.limit == u32::MAX;
         let how = (guaranteed, kept && lazy);
-        let chosen = self.choose(sc, bottom, (state, track), (&cand, how), &mut flights)?;
+        let chosen = self.choose(sc, bottom, (state, track), (cand, how), &mut flights)?;
         let depth = chosen.depths[0];
         let flown = fly_committed(sc, (state, track), depth, cand.flown, &mut flights)?;
         let minima = if chosen.previous {
@@ -114,8 +114,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let safe = chosen.cert.all >= cand.h_safe;
         self.line_j += flown.score.j();
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
-        let status = self.status(sc, &cand, &chosen, safe);
-        Ok(self.answer(flown, &chosen, &cand, (status, safe), flights))
+        let status = self.status(sc, cand, &chosen, safe);
+        Ok(self.answer(flown, &chosen, cand, (status, safe), flights))
     }
 
     /// The continuation to commit and its certificate: the known one
@@ -221,29 +221,36 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         let shallow = sc.mission().depth_limits()[0];
         let horizon = (&self.work.z, self.horizon_len);
-        let c = self.candidate_continuation((track, len), (cand.flown.depth, horizon), shallow);
-        let cert_c = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
-        let candidate = Chosen::new(c, len, cert_c);
-        if cert_c.all >= cand.h_safe {
-            return Ok(candidate);
+        // (Few continuations held at once, each a quarter of a kilobyte of
+        // stack: the safest tried is kept as where it came from, rebuilt
+        // at the end.)
+        let mut c = self.candidate_continuation((track, len), (cand.flown.depth, horizon), shallow);
+        let cert_0 = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
+        if cert_0.all >= cand.h_safe {
+            return Ok(Chosen::new(c, len, cert_0));
         }
         // The candidate's depth, then the climb: the optimized later depths
         // may lead into a trap that the next call's horizon would see and
         // avoid, while the committed depth alone need not.
-        let (c2, cert_c2) = self.then_climb(sc, bottom, cand, ((&c, cert_c), len), flights);
+        let (c2, cert_c2) = self.then_climb(sc, bottom, cand, ((&c, cert_0), len), flights);
         if cert_c2.all >= cand.h_safe {
             return Ok(Chosen::new(c2, len, cert_c2));
         }
-        let (c, cert_c) = if cert_c2.all > cert_c.all {
-            (c2, cert_c2)
-        } else {
-            (c, cert_c)
-        };
-        // Anchors: the previous continuation, then the climb.
-        let prev = self.previous_continuation(track, len, shallow);
-        let mut best = candidate;
-        let anchors = prev.map(|p| (p, true)).into_iter();
-        for (a, is_prev) in anchors.chain([([shallow; MAX_TRACKS], false)]) {
+        let mut cert_c = cert_0;
+        if cert_c2.all > cert_c.all {
+            (c, cert_c) = (c2, cert_c2);
+        }
+        // Anchors: the previous continuation, then the climb. The safest
+        // tried: the candidate (`None`) or an anchor (`Some(is_prev)`).
+        let mut best = (None, cert_0);
+        let mut a = [shallow; MAX_TRACKS];
+        for is_prev in [true, false] {
+            if is_prev && !self.previous_into(track, len, &mut a) {
+                continue;
+            }
+            if !is_prev {
+                a = [shallow; MAX_TRACKS];
+            }
             let cert_a = match self.budget.known_anchor(is_prev, (&a, &c, cert_c), len) {
                 Some(known) => known,
                 None => {
@@ -256,14 +263,28 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 let found = self.search(sc, bottom, ends, len, cand.h_safe, flights);
                 return Ok(self.search_committed(sc, bottom, found, cand, flights));
             }
-            if cert_a.all > best.cert.all {
-                best = Chosen {
-                    searched: true,
-                    ..Chosen::new(a, len, cert_a)
-                };
+            if cert_a.all > best.1.all {
+                best = (Some(is_prev), cert_a);
             }
         }
-        Ok(best)
+        let (from, cert) = best;
+        match from {
+            None => {
+                let z = (cand.flown.depth, horizon);
+                let c = self.candidate_continuation((track, len), z, shallow);
+                Ok(Chosen::new(c, len, cert))
+            }
+            Some(is_prev) => {
+                a = [shallow; MAX_TRACKS];
+                if is_prev {
+                    let _ = self.previous_into(track, len, &mut a);
+                }
+                Ok(Chosen {
+                    searched: true,
+                    ..Chosen::new(a, len, cert)
+                })
+            }
+        }
     }
 
     /// The candidate's depth, then the shallowest allowed depth on every
@@ -330,7 +351,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// The previous call's continuation for tracks `track..track + len`,
-    /// if it covers them all.
+    /// if it covers them all (the climb to `shallow`, m, beyond them).
     fn previous_continuation(
         &self,
         track: usize,
@@ -338,10 +359,20 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         shallow: f32,
     ) -> Option<[f32; MAX_TRACKS]> {
         let mut a = [shallow; MAX_TRACKS];
+        self.previous_into(track, len, &mut a).then_some(a)
+    }
+
+    /// [`Planner::previous_continuation`] into the first `len` entries of
+    /// `a` (in place); false, `a` partly written, where it does not cover
+    /// them all.
+    fn previous_into(&self, track: usize, len: usize, a: &mut [f32; MAX_TRACKS]) -> bool {
         for (i, slot) in a.iter_mut().enumerate().take(len) {
-            *slot = self.cont.depth(track.saturating_add(i))?;
+            let Some(d) = self.cont.depth(track.saturating_add(i)) else {
+                return false;
+            };
+            *slot = d;
         }
-        Some(a)
+        true
     }
 
     /// The candidate continuation: the call's depth, the rest of its

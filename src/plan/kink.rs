@@ -63,7 +63,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// towards the depth the vehicle starts that track at, by `h_r − h_a`
     /// or half the way (`far`: doubling, up to the whole way), within the
     /// box; `None` when the track does not dive (a saturated climb is not
-    /// freed by either side) or no move lifts it.
+    /// freed by either side) or no move lifts it. (Not inlined: its
+    /// flights' state is not on the stack of the restart that follows.)
+    #[inline(never)]
     fn kink_start(
         &self,
         obj: &mut PlanObjective<'_, N>,

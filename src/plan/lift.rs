@@ -84,7 +84,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The restart point for later track `g`: `None` unless `g` is at its
     /// target (within the band's hundredth, or `tol`, m) and a lift of
-    /// track `g − 1` frees it where the horizon's `J` is lower.
+    /// track `g − 1` frees it where the horizon's `J` is lower. (Not
+    /// inlined: its flights' state is not on the stack of the restart that
+    /// follows.)
+    #[inline(never)]
     fn lift_start(
         &self,
         obj: &mut PlanObjective<'_, N>,

@@ -355,10 +355,15 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
             records,
             gn.then_some(&mut out.gn),
         );
-        let e = self
+        // (A match, not `map_err` and `?`: those copied the evaluation
+        // twice, a few hundred bytes of this frame under every SQP step.)
+        let e = match self
             .sc
             .evaluate_watched(self.start, self.track, z, self.count, &mut watch)
-            .map_err(Stop::Sim)?;
+        {
+            Ok(e) => e,
+            Err(err) => return Err(Stop::Sim(err)),
+        };
         out.rows = rows;
         // Each segment's least altitude above its track's target.
         for (c, &t) in out.c.iter_mut().zip(out.group.iter()).take(rows) {

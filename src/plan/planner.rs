@@ -182,7 +182,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if self.cfg.max_evaluations == u32::MAX {
             self.budget = Budget::NONE;
             let cand = self.candidate(sc, state, track)?;
-            return self.commit(sc, state, track, cand);
+            return self.commit(sc, state, track, &cand);
         }
         self.plan_within(sc, state, track, self.cfg.max_evaluations)
     }

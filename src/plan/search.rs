@@ -56,7 +56,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         h_safe: f32,
         flights: &mut u32,
     ) -> Chosen<N> {
-        let at = |t: f32| -> [f32; MAX_TRACKS] { crate::num::between(a, c, t) };
+        // (Continuations in place: each is a quarter of a kilobyte of stack.)
+        let at = |t: f32, out: &mut [f32; MAX_TRACKS]| crate::num::between_into(a, c, t, out);
+        let mut d = [0.0; MAX_TRACKS];
         let m = sc.mission();
         let rule = RootTol {
             tol: (SEARCH_SHARE * (m.reference_altitude() - m.min_altitude())).clamp(1e-3, 0.02),
@@ -78,7 +80,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 if !self.budget.afford(*flights) {
                     break;
                 }
-                let d = at(t);
+                at(t, &mut d);
                 let d = d.get(..len).unwrap_or(&[]);
                 self.tube.certify(sc, bottom, d, (h_safe, &mut *flights))
             } else {
@@ -90,10 +92,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
             bad = (t, cert.all - h_safe);
         }
-        let depths = if good.0 > 0.0 { at(good.0) } else { *a };
+        if good.0 > 0.0 {
+            at(good.0, &mut d);
+        } else {
+            d = *a;
+        }
         Chosen {
             searched: true,
-            ..Chosen::new(depths, len, good.1)
+            ..Chosen::new(d, len, good.1)
         }
     }
 
@@ -142,7 +148,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// worlds' certificate between `good` and `bad` (`t` with its margin
     /// over `h_safe`, m) with that certificate, or `None` where it did not
     /// move off `good`.
-    fn screened_root<F: Fn(f32) -> [f32; MAX_TRACKS]>(
+    fn screened_root<F: Fn(f32, &mut [f32; MAX_TRACKS])>(
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
@@ -153,11 +159,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Option<(f32, Certificate)> {
         let budget = self.budget;
         let mask = self.tube.critical();
+        let mut d = [0.0; MAX_TRACKS];
         let r = root::safe_boundary((good.0, Some(good.1)), (bad.0, Some(bad.1)), rule, |t| {
             if !budget.afford(*flights) {
                 return Err(());
             }
-            let d = at(t);
+            at(t, &mut d);
             let d = d.get(..len).unwrap_or(&[]);
             let cert = self.tube.certify_only(sc, bottom, d, mask, flights);
             Ok::<_, ()>((cert.all - h_safe, cert))

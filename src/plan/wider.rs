@@ -54,12 +54,23 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             beam: true,
             width: BEAM_WIDE,
         };
-        let (mut z, mut curvature) = (bounds.lo, [0.0; K]);
-        let mut log = ScanLog::default();
-        if scan_start(fl, &spec, &mut z, &mut curvature, &mut log).is_err() {
+        let Some(z) = wide_scan(fl, &spec) else {
             return iterations;
-        }
+        };
         self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
             .unwrap_or(iterations)
     }
+}
+
+/// The wide beam's start, if the scan flies. Not inlined: its log stays
+/// off the stack of the SQP that follows.
+#[inline(never)]
+fn wide_scan<const K: usize, const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    spec: &ScanSpec<'_, K>,
+) -> Option<[f32; K]> {
+    let (mut z, mut curvature) = (spec.bounds.lo, [0.0; K]);
+    let mut log = ScanLog::default();
+    scan_start(fl, spec, &mut z, &mut curvature, &mut log).ok()?;
+    Some(z)
 }

@@ -70,7 +70,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // (An abandoned candidate is counted as its whole share.)
             None => self.fallback_candidate(sc, state, track, (b.candidate, s.h_safe))?,
         };
-        self.commit(sc, state, track, cand)
+        self.commit(sc, state, track, &cand)
     }
 
     /// The call's budget split (module docs), and what the fallback costs.
@@ -149,7 +149,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// A budgeted call starts its optimizer from the previous continuation
     /// over the whole horizon (a certified point) instead of scanning the
-    /// newly visible track: the scan's flights go to the optimizer.
+    /// newly visible track: the scan's flights go to the optimizer. (Not
+    /// inlined: its depths are not on the stack of the call's candidate.)
+    #[inline(never)]
     fn warm_from_continuation(&mut self, track: usize, len: usize) {
         let Some(p) = self.previous(track, len) else {
             return;

@@ -48,7 +48,7 @@ impl<const N: usize> Tube<N> {
             self.at() == track && self.nominal.as_ref() == Some(state) && self.worlds == worlds;
         if !kept {
             self.worlds = worlds;
-            self.states = [*state; MAX_WORLDS];
+            self.states.fill(*state);
             self.critical.set([0; 3]);
             self.pending.clear();
             self.done = [0; MAX_WORLDS];
@@ -98,7 +98,7 @@ impl<const N: usize> Tube<N> {
             }
         }
         if failed {
-            self.states = [*state; MAX_WORLDS];
+            self.states.fill(*state);
             self.critical.set([0; 3]);
             self.track = track;
             self.pending.clear();
