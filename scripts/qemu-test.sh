@@ -7,7 +7,9 @@
 #   2. the smoke test on the Cortex-M7 (mps2-an500) and on the soft-float
 #      Cortex-M3 (lm3s6965evb, thumbv7m-none-eabi);
 #   3. the panic-freedom proof: examples/qemu_panic_never.rs links with
-#      panic-never in release, for both targets, and runs on the M4F;
+#      panic-never in release, for both targets, and runs on the M4F; its
+#      plan call's stack bounded over every path, at most 8 KiB on both
+#      (tools/qemu/stack_bound.py, tested by test_stack_bound.py);
 #   4. the defmt log example, decoded (cargo qemu-log);
 #   5. the real-time example (examples/qemu_realtime.rs): 0 deadline misses
 #      of the 10 Hz control task over a whole line, under -icount;
@@ -31,6 +33,14 @@ cargo test --release --target thumbv7m-none-eabi --test qemu_smoke
 say "target: panic-freedom proof (panic-never links in release), M4F and M3; run on the M4F"
 cargo build --release --target thumbv7m-none-eabi --example qemu_panic_never
 cargo run --release --target thumbv7em-none-eabihf --example qemu_panic_never
+
+say "target: a plan call's stack, static bound over every path, <= 8 KiB (M4F and M3)"
+python3 tools/qemu/test_stack_bound.py
+target_dir=$(cargo metadata --format-version 1 --no-deps 2>/dev/null |
+  sed -n 's/.*"target_directory":"\([^"]*\)".*/\1/p')
+for t in thumbv7em-none-eabihf thumbv7m-none-eabi; do
+  python3 tools/qemu/stack_bound.py "${target_dir:-target}/$t/release/examples/qemu_panic_never" --limit 8192
+done
 
 say "target: the planner's progress as a decoded defmt log (cargo qemu-log)"
 cargo qemu-log
