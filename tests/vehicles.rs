@@ -38,6 +38,38 @@ fn a_staircase_is_read_at_its_trend() {
     assert!(j <= 1.005 * 1.562_91e5, "track 2: J {j} vs the best");
 }
 
+/// A crawl down a sawtooth (`check_planner.py --seed 1201 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_1201_4`, track 1): past
+/// 1 111.3 m every step longer than a millimetre lands past one of the
+/// jumps of `J`, so BFGS took eleven steps of about 1 mm, each won by a
+/// dozen halvings, and `J` fell a few parts in 10⁵ each: 13 iterations (95
+/// flights), over the checker's 10. Two such slivers in a row end the run
+/// now, and the polish reads the trend. The f64 best: 4.65241e4 m³
+/// (1 111.820 m).
+#[test]
+fn a_crawl_down_a_sawtooth_is_cut_short() {
+    let t = &tracks_of("crawl", &UNCONSTRAINED, &[])[0];
+    let (j, it) = (t["J"].as_f64().unwrap(), t["iterations"].as_u64().unwrap());
+    assert!(it <= 10, "track 1: {it} iterations");
+    assert!(j <= 1.005 * 4.652_41e4, "track 1: J {j} vs the best");
+}
+
+/// A concave stretch (`check_planner.py --seed 1404 --vehicle
+/// tools/reference/vehicles/second.toml`, `unseen_1404_5`, track 2): `J`
+/// fell at least linearly along each step, the curvature guard skipped
+/// every update, and the metric stayed at its first short step, so the
+/// steps grew only with the gradient (0.34 m, then 0.39, 0.47, ... 2.8 m):
+/// 17 iterations, over the checker's 10. A full step with negative
+/// curvature now doubles the next. The f64 best from track 1's end:
+/// 1.097587e5 m³ (748.51 m).
+#[test]
+fn a_concave_stretch_is_walked_in_doubling_steps() {
+    let t = &tracks_of("concave", &UNCONSTRAINED, &[(0, 725.597)])[1];
+    let (j, it) = (t["J"].as_f64().unwrap(), t["iterations"].as_u64().unwrap());
+    assert!(it <= 10, "track 2: {it} iterations");
+    assert!(j <= 1.005 * 1.097_587e5, "track 2: J {j} vs the best");
+}
+
 /// Little pitch authority (`check_planner.py --seed 71 --vehicle`,
 /// `unseen_71_4`: 3 m/s, 15° pitch limit, a plant of positive gain): every
 /// track's dive or climb stays saturated, so every depth after the first

@@ -30,7 +30,22 @@
 //!   solve), and every trial point is projected on the box;
 //! - **reset**: if the Cholesky solve fails or does not give a descent
 //!   direction (only possible through rounding), `A` is reset to the
-//!   scaled identity.
+//!   scaled identity;
+//! - **negative curvature**: where the curvature guard skips the update
+//!   after a full step (`Yᵀ Δζ <= 0`: `J` falls at least linearly along
+//!   it, and the quadratic model has no minimum that way), `A` is halved,
+//!   so that the next step is twice as long for the same gradient: a metric
+//!   stuck at a short first step otherwise walks down a concave stretch in
+//!   steps that grow only with the gradient (17 iterations of 0.3 to 2.8 m
+//!   on `check_planner.py --seed 1404 --vehicle
+//!   tools/reference/vehicles/second.toml`, `unseen_1404_5` track 2);
+//! - **slivers**: a step the line search had to cut below 1/64 of
+//!   the direction, twice in a row, ends the run
+//!   ([`Status::LineSearchFailed`]): `J` is not smooth at the step's scale
+//!   (a depth loop that integrates conditionally makes it a sawtooth of
+//!   teeth centimetres wide, `plan/polish.rs`), every longer step lands
+//!   past a jump, and the run would crawl a few parts in 10⁵ of `J` an
+//!   iteration at the cost of a dozen halvings each.
 
 use nalgebra::SMatrix;
 
@@ -41,6 +56,14 @@ use super::{
 
 /// Relative tolerance of the curvature guard (see the module docs).
 const CURVATURE_TOL: f32 = 1e-6;
+
+/// A step shorter than this share of the direction is a sliver (module
+/// docs): six halvings of the line search.
+const SLIVER: f32 = 1.0 / 64.0;
+
+/// A step at least this share of the direction is the full step (the box
+/// may clip it by rounding).
+const FULL: f32 = 0.999;
 
 /// BFGS settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -191,6 +214,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut rescaled = informed;
     let mut skipped_updates = 0_u32;
     let mut iterations = 0_u32;
+    let mut slivers = 0_u32;
 
     let status = loop {
         let grad_norm = bounds.free_gradient_norm_v(&z, &g);
@@ -245,8 +269,18 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             update(a, &dz, &y, yd);
         } else {
             skipped_updates = skipped_updates.saturating_add(1);
+            // Negative curvature along a full step: the next one twice as
+            // long (module docs).
+            if norm(&dz) >= FULL * norm(&dir) {
+                *a *= 0.5;
+            }
         }
         let dj = j - t.j;
+        slivers = if norm(&dz) < SLIVER * norm(&dir) {
+            slivers.saturating_add(1)
+        } else {
+            0
+        };
         z = t.z;
         j = t.j;
         g = t.g;
@@ -263,6 +297,9 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         // Stopping rule 3.14b.
         if libm::fabsf(dj) <= cfg.tol.j_threshold(j) {
             break Status::Converged;
+        }
+        if slivers >= 2 {
+            break Status::LineSearchFailed;
         }
     };
     out.grad_norm = bounds.free_gradient_norm_v(&z, &g);

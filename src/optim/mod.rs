@@ -176,7 +176,8 @@ pub enum Status {
     /// The iteration cap was reached first.
     MaxIterations,
     /// No step along the search direction decreased the objective enough
-    /// within the backtracking cap (BFGS), or an evaluation failed (GD).
+    /// within the backtracking cap, or two steps in a row were slivers of
+    /// theirs (BFGS, module docs of `bfgs`), or an evaluation failed (GD).
     LineSearchFailed,
 }
 
