@@ -180,10 +180,23 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         track: usize,
     ) -> Result<Plan<N>, PlanError> {
         if self.cfg.max_evaluations == u32::MAX {
-            self.budget = Budget::NONE;
-            let cand = self.candidate(sc, state, track)?;
-            return self.commit(sc, state, track, &cand);
+            return self.plan_unbudgeted(sc, state, track);
         }
         self.plan_within(sc, state, track, self.cfg.max_evaluations)
+    }
+
+    /// [`Planner::plan`] without a flight budget: the candidate, then the
+    /// commit. Not inlined: its candidate is not on the stack of a
+    /// budgeted call.
+    #[inline(never)]
+    fn plan_unbudgeted(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+    ) -> Result<Plan<N>, PlanError> {
+        self.budget = Budget::NONE;
+        let cand = self.candidate(sc, state, track)?;
+        self.commit(sc, state, track, &cand)
     }
 }
