@@ -16,6 +16,7 @@ pub(crate) mod best;
 pub mod bfgs;
 pub(crate) mod constrained;
 pub(crate) mod dense;
+mod dual;
 pub mod gd;
 pub(crate) mod qp;
 pub(crate) mod root;
