@@ -173,6 +173,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// ([`PlannerConfig::max_evaluations`]) below what committing the
     /// fallback needs ([`PlanError::BudgetTooSmall`]), or a simulation that
     /// fails at the very start.
+    ///
+    /// Never inlined: one entry point, whose stack over every path
+    /// `tools/qemu/stack_bound.py` bounds from it.
+    #[inline(never)]
     pub fn plan(
         &mut self,
         sc: &Scenario<'_, N>,
