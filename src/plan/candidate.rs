@@ -68,7 +68,8 @@ pub(super) struct Candidate<const N: usize> {
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The call's candidate for `track` from `state`: the optimized (or
     /// scanned, or boundary) depth of the track with its nominal flight,
-    /// the rest of the horizon in the workspace, and the warm start kept.
+    /// moved off its waypoint's knife edge (`knife.rs`), the rest of the
+    /// horizon in the workspace, and the warm start kept.
     pub(super) fn candidate(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -78,6 +79,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut c = self.candidate_aimed(sc, state, track)?;
         // (What the commit certifies against: the certified altitude.)
         c.h_safe = sc.mission().min_altitude() + self.cfg.safety_margin;
+        self.off_the_edge(sc, state, track, &mut c);
         Ok(c)
     }
 
@@ -187,7 +189,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// boundary search then lands on the exact safe boundary instead of
     /// `m_p` above it. A horizon keeps the margin for the tracks after the
     /// first, which no boundary search corrects.
-    fn penalized<'a>(&self, sc: &Scenario<'a, N>, h: usize) -> Scenario<'a, N> {
+    pub(super) fn penalized<'a>(&self, sc: &Scenario<'a, N>, h: usize) -> Scenario<'a, N> {
         let margin = if h == 1 { 0.0 } else { self.cfg.penalty_margin };
         sc.with_penalty_altitude(sc.mission().min_altitude() + margin)
     }

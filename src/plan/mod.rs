@@ -144,6 +144,7 @@ mod flights;
 mod gaps;
 mod jump;
 mod kink;
+mod knife;
 mod lift;
 mod objective;
 mod planner;
