@@ -28,6 +28,7 @@ use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
 use super::fallback::Flown;
 use super::flights::Flights;
+use super::knife::on_edge;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
@@ -87,9 +88,36 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // needs it (the budget accounts for it at every call).
         let lazy = self.budget.limit == u32::MAX;
         let how = (guaranteed, kept && lazy);
-        let chosen = self.choose(sc, bottom, (state, track), (cand, how), &mut flights)?;
+        let mut chosen = self.choose(sc, bottom, (state, track), (cand, how), &mut flights)?;
+        let mut flown = fly_committed(
+            sc,
+            (state, track),
+            chosen.depths[0],
+            cand.flown,
+            &mut flights,
+        )?;
+        // The previous continuation on its waypoint's knife edge (`knife.rs`),
+        // the candidate off it: the candidate's way instead.
+        if chosen.previous
+            && on_edge(sc, track, &flown.next)
+            && !on_edge(sc, track, &cand.flown.next)
+        {
+            chosen = self.choose(
+                sc,
+                bottom,
+                (state, track),
+                (cand, (guaranteed, false)),
+                &mut flights,
+            )?;
+            flown = fly_committed(
+                sc,
+                (state, track),
+                chosen.depths[0],
+                cand.flown,
+                &mut flights,
+            )?;
+        }
         let depth = chosen.depths[0];
-        let flown = fly_committed(sc, (state, track), depth, cand.flown, &mut flights)?;
         let minima = if chosen.previous {
             self.cont.minima
         } else {

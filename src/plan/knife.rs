@@ -55,6 +55,25 @@ pub(super) fn offset<const N: usize>(next: &VehicleState<N>, end: f32) -> f32 {
     if after <= -before { after } else { before }
 }
 
+/// Waypoint `X_{track+1}` when a track follows it (the knife edge is the
+/// next track's), m.
+fn edge_waypoint<const N: usize>(sc: &Scenario<'_, N>, track: usize) -> Option<f32> {
+    let wp = sc.waypoints().positions();
+    let end = wp.get(track.saturating_add(1)).copied()?;
+    (track.saturating_add(2) < wp.len()).then_some(end)
+}
+
+/// Whether a flight of track `track` ending at `next` puts a sample
+/// within [`EDGE`] of the waypoint ending it, a track following.
+pub(super) fn on_edge<const N: usize>(
+    sc: &Scenario<'_, N>,
+    track: usize,
+    next: &VehicleState<N>,
+) -> bool {
+    // (NaN is not near.)
+    edge_waypoint(sc, track).is_some_and(|end| libm::fabsf(offset(next, end)) < EDGE)
+}
+
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// Moves the candidate off the knife edge of the waypoint that ends
     /// its track (module docs), when a next track follows, the candidate's
@@ -68,19 +87,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         track: usize,
         cand: &mut Candidate<N>,
     ) {
-        let wp = sc.waypoints().positions();
-        let (Some(&end), true) = (
-            wp.get(track.saturating_add(1)),
-            track.saturating_add(2) < wp.len(),
-        ) else {
+        let Some(end) = edge_waypoint(sc, track) else {
             return;
         };
-        let v0 = offset(&cand.flown.next, end);
-        // (NaN is not near.)
-        let near = libm::fabsf(v0) < EDGE;
-        if cand.cert.is_some() || !near {
+        if cand.cert.is_some() || !on_edge(sc, track, &cand.flown.next) {
             return;
         }
+        let v0 = offset(&cand.flown.next, end);
         let mut fl = Flights {
             // (The candidate's own flights' scenario.)
             sc: self.penalized(sc, self.horizon_len),
