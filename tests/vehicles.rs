@@ -182,3 +182,19 @@ fn an_interior_optimum_after_a_trip_is_read_at_its_trend() {
     let j = tracks[2]["J"].as_f64().unwrap();
     assert!(j <= 1.005 * 5_902.07, "track 3: J {j} vs the best safe");
 }
+
+/// A restoring plateau scan that took a saturated climb's shallowest point
+/// (`check_planner.py --seed 1705 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP
+/// ended 59.7 m short with track 1's depth on a plateau, and the scan of
+/// `z_1` kept the point of least shortfall, 655.5 m (0.58 m short, the
+/// line's `J` 9.9e7 m³), over 1 111.9 m (0.69 m short, 3.6e7 m³): no
+/// gradient leaves a plateau, and the line's `J` ended 9.2938e7 m³, 4.43×
+/// the f64 beam search's best safe plan (2.09871e7 m³: 1 195.1, 1 007.9,
+/// 866.9, 729.0, 607.7 m). The points less infeasible than the optimum
+/// are now weighed by `J` with their shortfall priced as the non-restoring
+/// scan prices it (`plan/jump.rs`): 1.003×.
+#[test]
+fn a_restoring_plateau_scan_weighs_j_against_the_shortfall() {
+    horizon_within("restore_merit", 1.01, 2.098_709e7);
+}

@@ -14,10 +14,21 @@
 //! lower, the pair is bisected [`EDGE`] times (one flight of the tail
 //! each) for the feasible point nearest the cliff.
 //!
+//! From an infeasible optimum, the scan weighs the points less infeasible
+//! than it by `J` plus their shortfall priced at [`RESTORE_SHARE`] of the
+//! merit weight, as it weighs a feasible optimum's. It took the point of
+//! least shortfall before: on a random line on the `rate` vehicle
+//! (`check_planner.py --seed 1705`, `unseen_1705_2`) the cold SQP ended
+//! 59.7 m short, and the scan of track 1's saturated climb kept its
+//! shallowest point (655.5 m, 0.58 m short, the line's `J` 9.9e7 m³) over
+//! 1 111.9 m (0.69 m short, 3.6e7 m³); on the plateau no gradient moved
+//! it back, and the line ended 4.43× the best safe plan: now 1.003×.
+//!
 //! Where the scan finds no lower point and track `j` is held at its
 //! target by the depths before it, the restart starts just off the
 //! plateau's edge instead ([`Planner::held_edge`]'s docs).
 
+use crate::num::max;
 use crate::optim::Bounds;
 use crate::sim::{TrackScore, VehicleState};
 
@@ -81,13 +92,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // plateau).
         let t = obj.track.saturating_add(j);
         let (lo, hi) = reach_from(&obj.sc, t, at_j.depth(), (lo, hi));
-        // Scores a point: restoring, the feasible points first, by `J`
-        // (the least shortfall alone would take the worst of several
-        // feasible depths), then the rest by shortfall.
+        // Scores a point: restoring, the points less infeasible than the
+        // optimum by `J` with their shortfall priced as below (the least
+        // shortfall alone would take the worst of several feasible depths,
+        // or a saturated climb's shallowest point: module docs).
+        let price = RESTORE_SHARE * rho;
         let score = |(_, jz, v): Point| -> Option<((f32, f32), (f32, f32))> {
             if restoring {
-                let key = if v <= tol { (0.0, jz) } else { (v, 0.0) };
-                Some((key, (v_now - tol, 0.0)))
+                let merit = jz + price * max(v - tol, 0.0);
+                (v < v_now - tol).then_some(((0.0, merit), (0.0, f32::INFINITY)))
             } else if v <= band && jz + RESTORE_SHARE * rho * v < threshold {
                 Some(((0.0, jz), (0.0, threshold)))
             } else {
