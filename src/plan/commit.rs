@@ -28,7 +28,7 @@ use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
 use super::fallback::Flown;
 use super::flights::Flights;
-use super::knife::on_edge;
+use super::knife::{nominal, on_edge};
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
@@ -99,6 +99,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The previous continuation on its waypoint's knife edge (`knife.rs`),
         // the candidate off it: the candidate's way instead.
         if chosen.previous
+            && nominal(sc)
             && on_edge(sc, track, &flown.next)
             && !on_edge(sc, track, &cand.flown.next)
         {
