@@ -169,17 +169,34 @@ static int is(const char *sym, const char *name)
     return sym != NULL && strcmp(sym, name) == 0;
 }
 
+/* Each marker's entry address: the first block translated in it. */
+static uint64_t start_entry = UINT64_MAX;
+static uint64_t stop_entry = UINT64_MAX;
+
+/* Whether `at` is the marker's entry, `*seen` its first block's address
+ * (set by the first call). */
+static int entry(uint64_t *seen, uint64_t at)
+{
+    if (*seen == UINT64_MAX) {
+        *seen = at;
+    }
+    return *seen == at;
+}
+
 static void on_translate(qemu_plugin_id_t id, struct qemu_plugin_tb *tb)
 {
     size_t n = qemu_plugin_tb_n_insns(tb);
     (void)id;
     if (n > 0) {
         const char *sym = qemu_plugin_insn_symbol(qemu_plugin_tb_get_insn(tb, 0));
-        /* The markers are only ever entered by a call, so a block that
-         * starts in one starts at its entry. */
-        if (is(sym, "auvnav_bench_start")) {
+        uint64_t at = qemu_plugin_tb_vaddr(tb);
+        /* The markers are only ever entered by a call, so the first block
+         * translated in one starts at its entry; a later block in it (a
+         * marker that crosses a 1 KiB page, where QEMU splits blocks) is
+         * not an entry, and is not a marker. */
+        if (is(sym, "auvnav_bench_start") && entry(&start_entry, at)) {
             qemu_plugin_register_vcpu_tb_exec_cb(tb, on_start, QEMU_PLUGIN_CB_NO_REGS, NULL);
-        } else if (is(sym, "auvnav_bench_stop")) {
+        } else if (is(sym, "auvnav_bench_stop") && entry(&stop_entry, at)) {
             qemu_plugin_register_vcpu_tb_exec_cb(tb, on_stop, QEMU_PLUGIN_CB_NO_REGS, NULL);
         }
     }
