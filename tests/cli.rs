@@ -1250,3 +1250,17 @@ fn a_stalled_infeasible_horizon_stops() {
         assert!(n <= 300, "track {}: {n} flights", t["track"]);
     }
 }
+
+/// A later track held through a plateau, freed only further off its edge
+/// (`tools/reference/check_planner.py --unseen 8 --seed 1801`,
+/// `unseen_1801_2`): track 2's depth on a saturated dive's plateau, track
+/// 3's least altitude at its target, held by track 1's depth. Just off
+/// the plateau's edge track 3 was freed by 4.5 cm, under the slack, so
+/// the cold call kept its local optimum: the line's `J` 5.6588e6 m³,
+/// 1.51× the f64 beam search's best safe plan (3.73824e6 m³: 682.9,
+/// 925.4, 758.1, 1 144.9, 1 100.1 m). The edge steps further off now
+/// (`plan/jump.rs`): 1.0027×.
+#[test]
+fn a_later_track_held_through_a_plateau_is_freed_further_off() {
+    horizon_within("freed_far", 1.01, 3.738_24e6);
+}

@@ -198,3 +198,15 @@ fn an_interior_optimum_after_a_trip_is_read_at_its_trend() {
 fn a_restoring_plateau_scan_weighs_j_against_the_shortfall() {
     horizon_within("restore_merit", 1.01, 2.098_709e7);
 }
+
+/// The shape of `a_later_track_held_through_a_plateau_is_freed_further_off`
+/// (`tests/cli.rs`) on the `second` vehicle (`check_planner.py --seed
+/// 1706 --vehicle tools/reference/vehicles/second.toml`, `unseen_1706_7`):
+/// track 3 held by track 1's depth through track 2's plateau, freed by
+/// 1.3 cm just off its edge; the line's `J` 8.8628e5 m³, 3.22× the f64
+/// best safe plan (2.755815e5 m³: 1 070.7, 1 232.3, 1 385.7, 1 390.5 m).
+/// Now 1.0025×.
+#[test]
+fn a_later_track_held_through_a_plateau_is_freed_on_a_second_order_vehicle() {
+    horizon_within("freed_far_second", 1.01, 2.755_815e5);
+}

@@ -26,7 +26,19 @@
 //!
 //! Where the scan finds no lower point and track `j` is held at its
 //! target by the depths before it, the restart starts just off the
-//! plateau's edge instead ([`Planner::held_edge`]'s docs).
+//! plateau's edge instead ([`Planner::held_edge`]'s docs). A later track
+//! held through the plateau may be freed only a hair just off its edge
+//! and by metres further off: on `check_planner.py --seed 1801`
+//! (`unseen_1801_2`, default vehicle) track 2's depth sat on a saturated
+//! dive's plateau and track 3's least altitude at its target, held by
+//! track 1's depth; just off the edge (941.9 m) track 3 was freed by
+//! 4.5 cm, under the slack, 20 m further off by 5 m. The best safe plan
+//! flies track 1 46 m deeper and track 2 77 m shallower, past a middle
+//! where the straight path is infeasible (track 3 down to 42 m): no
+//! local step gets there, and the line's `J` was 1.51× the f64 best.
+//! The edge now steps further off, by the band and doubling
+//! ([`FREE_STEPS`] tail flights at most), until the held track is freed:
+//! 1.0027×; `unseen_1706_7` (`second`, the same shape) 3.22× → 1.0025×.
 
 use crate::num::max;
 use crate::optim::Bounds;
@@ -40,6 +52,10 @@ use super::solve::{RESTORE_SHARE, lex_less};
 /// Bisections of a scan's step from a point within the band to one
 /// beyond it with a lower `J`.
 const EDGE: u32 = 3;
+
+/// Steps further off a plateau's edge (the band `h_r − h_a`, doubling)
+/// that [`Planner::held_edge`] tries for a later track held just off it.
+const FREE_STEPS: u32 = 3;
 
 /// A scanned point's `J` within this share of the optimum's is on its
 /// plateau.
@@ -162,7 +178,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `(on, off)` of the scan is bisected [`EDGE`] times (one flight of
     /// the tail each), and the point off the plateau (within the band)
     /// returned, with its `J` as its score: the restart is kept only if it
-    /// ends lower. `None` when track `j` is not held.
+    /// ends lower. A later track held (`later`) must be freed there by
+    /// more than the slack; else the point steps further off, by the band
+    /// and doubling, [`FREE_STEPS`] times at most (module docs). `None`
+    /// when track `j` is not held, or the later track is not freed.
     fn held_edge(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -189,10 +208,21 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 break;
             }
         }
-        let start = with_depth(z, j, off.0);
+        let mut start = with_depth(z, j, off.0);
         // A later track held must be freed off the plateau: else the
-        // linearization there sees no trade either.
-        let freed = g == j || obj.least_at((at_j, j), &start, g).ok()? > least + slack;
+        // linearization there sees no trade either. Just off the edge it
+        // may be freed by a hair; further off, by more (module docs).
+        let mut freed = g == j || obj.least_at((at_j, j), &start, g).ok()? > least + slack;
+        let away = if off.0 < on.0 { -band } else { band };
+        let mut step = away;
+        for _ in 0..FREE_STEPS {
+            if freed {
+                break;
+            }
+            start = with_depth(z, j, off.0 + step);
+            freed = obj.least_at((at_j, j), &start, g).ok()? > least + slack;
+            step *= 2.0;
+        }
         freed.then_some(((0.0, off.1), start))
     }
 
