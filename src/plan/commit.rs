@@ -88,14 +88,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // needs it (the budget accounts for it at every call).
         let lazy = self.budget.limit == u32::MAX;
         let how = (guaranteed, kept && lazy);
-        let mut chosen = self.choose(sc, bottom, (state, track), (cand, how), &mut flights)?;
-        let mut flown = fly_committed(
-            sc,
-            (state, track),
-            chosen.depths[0],
-            cand.flown,
-            &mut flights,
-        )?;
+        let at = (state, track);
+        let (mut chosen, mut flown) =
+            self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
         // The previous continuation on its waypoint's knife edge (`knife.rs`),
         // the candidate off it: the candidate's way instead.
         if chosen.previous
@@ -103,20 +98,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             && on_edge(sc, track, &flown.next)
             && !on_edge(sc, track, &cand.flown.next)
         {
-            chosen = self.choose(
-                sc,
-                bottom,
-                (state, track),
-                (cand, (guaranteed, false)),
-                &mut flights,
-            )?;
-            flown = fly_committed(
-                sc,
-                (state, track),
-                chosen.depths[0],
-                cand.flown,
-                &mut flights,
-            )?;
+            let how = (guaranteed, false);
+            (chosen, flown) = self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
         }
         let depth = chosen.depths[0];
         let minima = if chosen.previous {
@@ -145,6 +128,21 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
         let status = self.status(sc, cand, &chosen, safe);
         Ok(self.answer(flown, &chosen, cand, (status, safe), flights))
+    }
+
+    /// [`Planner::choose`], with the chosen depth's nominal flight.
+    fn choose_flown(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (state, track): (&VehicleState<N>, usize),
+        (cand, how): (&Candidate<N>, (bool, bool)),
+        flights: &mut u32,
+    ) -> Result<(Chosen<N>, Flown<N>), PlanError> {
+        let chosen = self.choose(sc, bottom, (state, track), (cand, how), flights)?;
+        let depth = chosen.depths[0];
+        let flown = fly_committed(sc, (state, track), depth, cand.flown, flights)?;
+        Ok((chosen, flown))
     }
 
     /// The continuation to commit and its certificate: the known one
