@@ -208,22 +208,22 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 break;
             }
         }
-        let mut start = with_depth(z, j, off.0);
+        if g == j {
+            return Some(((0.0, off.1), with_depth(z, j, off.0)));
+        }
         // A later track held must be freed off the plateau: else the
         // linearization there sees no trade either. Just off the edge it
         // may be freed by a hair; further off, by more (module docs).
-        let mut freed = g == j || obj.least_at((at_j, j), &start, g).ok()? > least + slack;
         let away = if off.0 < on.0 { -band } else { band };
-        let mut step = away;
-        for _ in 0..FREE_STEPS {
-            if freed {
-                break;
+        let mut step = 0.0;
+        for _ in 0..=FREE_STEPS {
+            let start = with_depth(z, j, off.0 + step);
+            if obj.least_at((at_j, j), &start, g).ok()? > least + slack {
+                return Some(((0.0, off.1), start));
             }
-            start = with_depth(z, j, off.0 + step);
-            freed = obj.least_at((at_j, j), &start, g).ok()? > least + slack;
-            step *= 2.0;
+            step = if step == 0.0 { away } else { 2.0 * step };
         }
-        freed.then_some(((0.0, off.1), start))
+        None
     }
 
     /// A cold horizon's last escape: [`Planner::held_edge`] for a track
