@@ -260,8 +260,10 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         let dz = t.z - z;
         let y = t.g - g;
         let yd = dot(&y, &dz);
+        // The step's length and the direction's, m.
+        let (step, along) = (norm(&dz), norm(&dir));
         // Curvature guard: only a positive Yᵀ Δζ keeps A positive definite.
-        if yd > CURVATURE_TOL * norm(&y) * norm(&dz) {
+        if yd > CURVATURE_TOL * norm(&y) * step {
             if !rescaled {
                 *a = SMatrix::identity() * (dot(&y, &y) / yd);
                 rescaled = true;
@@ -271,12 +273,12 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             skipped_updates = skipped_updates.saturating_add(1);
             // Negative curvature along a full step: the next one twice as
             // long (module docs).
-            if norm(&dz) >= FULL * norm(&dir) {
+            if step >= FULL * along {
                 *a *= 0.5;
             }
         }
         let dj = j - t.j;
-        slivers = if norm(&dz) < SLIVER * norm(&dir) {
+        slivers = if step < SLIVER * along {
             slivers.saturating_add(1)
         } else {
             0
@@ -291,7 +293,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             iterations,
             j,
             norm(&g),
-            norm(&dz),
+            step,
             evaluations
         );
         // Stopping rule 3.14b.
