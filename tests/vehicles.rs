@@ -183,6 +183,25 @@ fn an_interior_optimum_after_a_trip_is_read_at_its_trend() {
     assert!(j <= 1.005 * 5_902.07, "track 3: J {j} vs the best safe");
 }
 
+/// A boundary optimum on a sawtooth (`check_planner.py --seed 1902
+/// --vehicle tools/reference/vehicles/integ.toml`, `unseen_1902_0`,
+/// constrained track by track). Track 1's `J` falls into the safe set
+/// from its boundary, but each run of the optimizer from the boundary
+/// stepped on a tooth's slope out of the safe set again, and the track
+/// kept the boundary: 660.17 m, `J` 35 803.9 m³, 1.0087× the f64 best
+/// safe 35 495.9 m³ (659.09 m; checker's bound 1.005×). The polish's
+/// search from the boundary reads the trend: 658.67 m, 1.0004×.
+#[test]
+fn a_boundary_on_a_sawtooth_gives_way_to_the_trend() {
+    let t = &tracks_of("boundary_sawtooth", &["--mode", "track"], &[])[0];
+    let (j, h) = (
+        t["J"].as_f64().unwrap(),
+        t["min_altitude"].as_f64().unwrap(),
+    );
+    assert!(h >= 60.0, "track 1: least altitude {h}");
+    assert!(j <= 1.005 * 35_495.9, "track 1: J {j} vs the best safe");
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP

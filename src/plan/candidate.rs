@@ -357,11 +357,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// After a trip, when the optimizer only overshot: where `J` falls
     /// from the boundary `f` into the safe set (away from the trip at
     /// `z_bad`, a finite difference of `CHECK_STEP` or, if not, of a
-    /// quarter of it), the optimum is
-    /// interior and the guarded optimizer runs once more from the boundary
-    /// (its steps only lower `J`), then the polish (`polish.rs`) under
-    /// BFGS; its candidate unless it trips again. Unbudgeted calls only
-    /// (the budgeted ones keep the boundary).
+    /// quarter of it), the optimum is interior and the guarded optimizer
+    /// runs once more from the boundary (its steps only lower `J`), then
+    /// under BFGS the polish (`polish.rs`); if it trips again, under BFGS
+    /// the polish's search from the boundary, else the boundary.
+    /// Unbudgeted calls only (the budgeted ones keep the boundary).
     fn inward(
         &mut self,
         fl: &mut Flights<'_, '_, N>,
@@ -390,13 +390,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let run = (self.cfg.bfgs.first_step, self.cfg.bfgs.max_iterations);
         let zero = [0.0; K];
         let ran = self.optimize_onto(obj, &z0, &s.bounds, run, &zero, Merge::First);
+        let bfgs = self.cfg.method == Method::Bfgs;
         if obj.tripped.is_some() || ran.is_err() {
-            fl.count = fl.count.saturating_add(obj.evaluations);
-            return Ok(None);
-        }
-        // (An interior optimum, as the unconstrained track's: where the
-        // depth loop integrates, `J` may be a sawtooth there.)
-        if self.cfg.method == Method::Bfgs {
+            // (A sawtooth's teeth may point out, its trend in: polish.rs.)
+            if !(bfgs && self.polish_boundary(obj, &s.bounds, (f.depth, f.score.j()))) {
+                fl.count = fl.count.saturating_add(obj.evaluations);
+                return Ok(None);
+            }
+        } else if bfgs {
+            // (An interior optimum: `J` may be a sawtooth there too.)
             let guard = obj.guard;
             self.polish_single(obj, &s.bounds, guard);
         }
