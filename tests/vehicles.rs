@@ -202,6 +202,24 @@ fn a_boundary_on_a_sawtooth_gives_way_to_the_trend() {
     assert!(j <= 1.005 * 35_495.9, "track 1: J {j} vs the best safe");
 }
 
+/// A plateau's restart that ended past the safe set (`check_planner.py
+/// --seed 2002 --vehicle tools/reference/vehicles/integ.toml`,
+/// `unseen_2002_7`, constrained track by track). Track 3's depth is on a
+/// saturated climb's plateau up to about 60 m; the restart from its edge
+/// ended at 159.5 m, in a tooth 12 m past the safe boundary, and was
+/// dropped: the track stayed at 0 m, `J` 2.90352e6 m³, 1.020× the f64
+/// best safe 2.846392e6 m³ (143.1 m, from the state the tool's tracks 1
+/// and 2 leave). Now the boundary between the edge and that end, then the
+/// polish's search from it.
+#[test]
+fn a_plateau_restart_past_the_safe_set_keeps_its_boundary() {
+    let premise = [(0, 564.715), (1, 407.451)];
+    let t = &tracks_of("plateau_boundary", &["--mode", "track"], &premise)[2];
+    let (j, h) = (t["J"].as_f64().unwrap(), t["min_altitude"].as_f64().unwrap());
+    assert!(h >= 60.0, "track 3: least altitude {h}");
+    assert!(j <= 1.005 * 2.846_392e6, "track 3: J {j} vs the best safe");
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP

@@ -6,12 +6,16 @@
 //! depth flies the same). The edge is found by stepping out of the
 //! plateau (steps doubling from 1/64 of the box) and a few halvings; the
 //! optimizer restarts from the first depth past it, on each side, and its
-//! answer is kept if it ends lower. (A horizon scans its flat
+//! answer is kept if it ends lower; a constrained track's, ended past the
+//! safe set, keeps the boundary between the edge and its end if that is
+//! lower ([`Planner::boundary_off_plateau`]). (A horizon scans its flat
 //! coordinates instead, `solve.rs`.)
 
 use crate::num::{max, min};
 use crate::optim::Bounds;
 
+use super::fallback::boundary;
+use super::flights::Flights;
 use super::objective::PlanObjective;
 use super::solve::Merge;
 use super::{PlanError, Planner};
@@ -84,7 +88,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         bounds: &Bounds<K>,
         run: (f32, u32),
     ) -> Result<Option<u32>, PlanError> {
-        let kept = self.work.mark();
+        let (kept, flat) = (self.work.mark(), self.work.j);
         let guard = obj.guard.take();
         let zero = [0.0; K];
         let taken = self.optimize_onto(obj, start, bounds, run, &zero, Merge::IfBetter);
@@ -100,11 +104,56 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             .flight(&end)
             .ok()
             .and_then(|s| s.first().map(|s| s.min_altitude() >= h_safe));
-        if safe == Some(true) {
+        let edge = start.first().copied().unwrap_or(0.0);
+        let past = end.first().copied().unwrap_or(edge);
+        if safe == Some(true)
+            || self.boundary_off_plateau(obj, bounds, (edge, past), (flat, h_safe))
+        {
             return Ok(Some(taken));
         }
         self.work.restore(&kept);
         Ok(None)
+    }
+
+    /// A guarded restart from the plateau's edge `edge` that ended past
+    /// the safe set at `past` (m): the safe-set boundary between them,
+    /// kept where its `J` is below the plateau's `flat` (m³), then the
+    /// polish's search from it (`polish.rs`; the run may have overshot an
+    /// interior optimum, as on a sawtooth). On `check_planner.py --seed
+    /// 2002 --vehicle tools/reference/vehicles/integ.toml`,
+    /// `unseen_2002_7` track 3, constrained, the restart ended 12 m past
+    /// the boundary in a tooth and the track stayed on its climb's
+    /// plateau: 1.020× the best safe `J`. Whether it found one (the
+    /// workspace then there).
+    fn boundary_off_plateau(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        bounds: &Bounds<K>,
+        (edge, past): (f32, f32),
+        (flat, h_safe): (f32, f32),
+    ) -> bool {
+        let mut fl = Flights {
+            sc: obj.sc,
+            state: obj.start,
+            track: obj.track,
+            count: 0,
+            limit: obj.budget.saturating_sub(obj.evaluations),
+        };
+        let steps = self.cfg.bisection_steps;
+        let b = boundary(&mut fl, (edge, None), (past, None), h_safe, steps);
+        obj.evaluations = obj.evaluations.saturating_add(fl.count);
+        let Some(at) = b.ok().map(|b| b.at) else {
+            return false;
+        };
+        let j = at.score.j();
+        if !(j < flat && at.score.min_altitude() >= h_safe) {
+            return false;
+        }
+        if !self.polish_boundary(obj, bounds, (at.depth, j)) {
+            self.work.j = j;
+            let _ = self.work.history.push(j);
+        }
+        true
     }
 }
 
