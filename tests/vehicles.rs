@@ -215,7 +215,10 @@ fn a_boundary_on_a_sawtooth_gives_way_to_the_trend() {
 fn a_plateau_restart_past_the_safe_set_keeps_its_boundary() {
     let premise = [(0, 564.715), (1, 407.451)];
     let t = &tracks_of("plateau_boundary", &["--mode", "track"], &premise)[2];
-    let (j, h) = (t["J"].as_f64().unwrap(), t["min_altitude"].as_f64().unwrap());
+    let (j, h) = (
+        t["J"].as_f64().unwrap(),
+        t["min_altitude"].as_f64().unwrap(),
+    );
     assert!(h >= 60.0, "track 3: least altitude {h}");
     assert!(j <= 1.005 * 2.846_392e6, "track 3: J {j} vs the best safe");
 }

@@ -124,7 +124,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `unseen_2002_7` track 3, constrained, the restart ended 12 m past
     /// the boundary in a tooth and the track stayed on its climb's
     /// plateau: 1.020× the best safe `J`. Whether it found one (the
-    /// workspace then there).
+    /// workspace then there). Not inlined: its flights stay off the
+    /// restart's frame.
+    #[inline(never)]
     fn boundary_off_plateau(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
