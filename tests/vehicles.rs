@@ -223,6 +223,20 @@ fn a_plateau_restart_past_the_safe_set_keeps_its_boundary() {
     assert!(j <= 1.005 * 2.846_392e6, "track 3: J {j} vs the best safe");
 }
 
+/// A cold SQP run converged on a sliver of a step (`check_planner.py
+/// --seed 1902 --vehicle tools/reference/vehicles/integ.toml`,
+/// `unseen_1902_0`): its first step took `z_2` off a plateau, and the
+/// metric's next step was cut to α = 9e-6; the 2 mm move changed the
+/// merit by less than the tolerance, with every track 16 m or more above
+/// its target and `J` still falling at 23 400 m³/m in `z_4`. The line's
+/// `J` was 2.88446e6 m³, 1.41× the f64 beam search's best safe plan
+/// (2.04008e6 m³; checker's bound 1.10×). Restarted from there with a
+/// fresh metric: 1.095×.
+#[test]
+fn a_run_converged_on_a_sliver_is_restarted() {
+    horizon_within("sliver_restart", 1.10, 2.040_08e6);
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP

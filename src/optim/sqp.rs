@@ -84,6 +84,10 @@ const RESTORED: f32 = 0.5;
 /// along the secant of `v` to zero, by at most this factor.
 const SECANT_REACH: f32 = 4.0;
 
+/// An accepted step below this share of the QP's is a sliver
+/// ([`SqpEnd::sliver`]).
+pub(crate) const SLIVER: f32 = 1e-3;
+
 /// Infeasible iterations in a row that leave the merit `φ` unmoved (within
 /// the relative tolerance) before the run counts as stalled: on an
 /// infeasible random line (`check_planner.py --seed 43`, `unseen_43_6`)
@@ -131,6 +135,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         skipped: 0,
         stalls: 0,
         careful,
+        sliver: false,
     };
     obj.linearize(&run.z, true, &mut run.lin)
         .map_err(OptimError::Start)?;
@@ -184,6 +189,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
         returned,
         left: (returned && left_j < run.lin.j).then_some(left),
+        sliver: status == Status::Converged && run.sliver && !returned,
     })
 }
 
@@ -201,6 +207,10 @@ pub(crate) struct SqpEnd<const K: usize> {
     pub returned: bool,
     /// Where it ended before it went back, if its `J` was lower there.
     pub left: Option<[f32; K]>,
+    /// Whether it converged on a step that the line search cut below
+    /// [`SLIVER`] of the QP's: the metric that chose the step may be out
+    /// of scale, and the end not an optimum.
+    pub sliver: bool,
 }
 
 /// How close to zero (m) a row's `c` counts as active at the end: the
@@ -230,6 +240,8 @@ struct Run<const K: usize> {
     /// Whether the QP also takes the rows beyond the band its step would
     /// cross.
     careful: bool,
+    /// Whether the last accepted step was a sliver of the QP's.
+    sliver: bool,
 }
 
 impl<const K: usize> Run<K> {
@@ -323,7 +335,7 @@ impl<const K: usize> Run<K> {
             alpha
         );
         let small = libm::fabsf(phi - phi_new) <= cfg.tol.j_threshold(phi_new);
-        let _ = alpha;
+        self.sliver = alpha < SLIVER;
         self.stop_after(small, feas_tol)
     }
 
