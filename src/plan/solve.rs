@@ -215,40 +215,43 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         Ok((iterations, scanned | skip))
     }
 
-    /// A first run's follow-ups, from its `end`: gone back, once more
-    /// careful; converged on a sliver, once more with a fresh metric.
-    /// Returns the iterations so far.
+    /// A first run's follow-up, from its `end`: gone back, or converged on
+    /// a sliver, once more, careful, with a fresh metric, kept if it ends
+    /// better. Returns the iterations so far.
     fn follow_up(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         end: &SqpEnd<K>,
         (h, bounds): (usize, &Bounds<K>),
         tol: f32,
-        mut iterations: u32,
+        iterations: u32,
     ) -> u32 {
-        let rho = end.rho;
+        if iterations >= self.cfg.bfgs.max_iterations {
+            return iterations;
+        }
         // Gone back (`optim/best.rs`): once more, careful, the merit weight
         // learnt, from there or the edge towards where it left (`edge.rs`).
-        if end.returned && iterations < self.cfg.bfgs.max_iterations {
+        // Converged on a sliver (`SqpEnd::sliver`): once more from there,
+        // careful (a metric out of scale proposes long steps, which a
+        // careful QP checks against the rows beyond the band they cross).
+        // On a random line on the `integ` vehicle (`check_planner.py
+        // --seed 1902`, `unseen_1902_0`) the cold run's first step took
+        // `z_2` off its plateau; the metric's next step, (−210, −52, 0,
+        // +235) m, was cut to α = 9e-6, and the run converged there with
+        // every track 16 m or more above its target and `∂J/∂z_4` =
+        // −23 400 m³/m: the line's `J` 1.41× the f64 best safe plan's;
+        // restarted, 1.005× (1.095× not careful).
+        let from = if end.returned {
             let edge = end.left.and_then(|l| self.edge_toward(obj, &l, tol));
-            let z = edge.unwrap_or(self.work.z);
-            let again = self.sqp_restart(obj, &z, (h, bounds), (tol, rho, true), iterations);
-            iterations = again.unwrap_or(iterations);
-        }
-        // Converged on a sliver (`SqpEnd::sliver`): once more from there
-        // with a fresh metric, kept if it ends lower. On a random line on
-        // the `integ` vehicle (`check_planner.py --seed 1902`,
-        // `unseen_1902_0`) the cold run's first step took `z_2` off its
-        // plateau; the metric's next step, (−210, −52, 0, +235) m, was cut
-        // to α = 9e-6, and the run converged there with every track 16 m
-        // or more above its target and `∂J/∂z_4` = −23 400 m³/m: the
-        // line's `J` 1.41× the f64 best safe plan's; restarted, 1.095×.
-        if end.sliver && iterations < self.cfg.bfgs.max_iterations {
-            let z = self.work.z;
-            let again = self.sqp_restart(obj, &z, (h, bounds), (tol, rho, false), iterations);
-            iterations = again.unwrap_or(iterations);
-        }
-        iterations
+            Some(edge.unwrap_or(self.work.z))
+        } else {
+            end.sliver.then_some(self.work.z)
+        };
+        let Some(z) = from else {
+            return iterations;
+        };
+        let again = self.sqp_restart(obj, &z, (h, bounds), (tol, end.rho, true), iterations);
+        again.unwrap_or(iterations)
     }
 
     /// The SQP restarted from `z` with the merit weight `rho` (m³/m; 0:
