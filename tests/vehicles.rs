@@ -237,6 +237,20 @@ fn a_run_converged_on_a_sliver_is_restarted() {
     horizon_within("sliver_restart", 1.01, 2.040_08e6);
 }
 
+/// A later track held through a plateau that stepping off it does not
+/// free (`check_planner.py --seed 2005 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_2005_5`): the cold SQP
+/// ended with `z_3` on a saturated dive's plateau and track 4 held at its
+/// target by `z_2`, whose `J` still fell at 76 400 m³/m. Off the edge,
+/// `z_3` shallower lowers track 4 (so the held edge gave no restart), but
+/// there the linearization sees `z_3`, which takes over holding track 4
+/// and lets `z_2` go 87 m deeper. The line's `J` was 3.774e6 m³, 3.40×
+/// the f64 beam search's best safe plan (1.110196e6 m³); now 1.0002×.
+#[test]
+fn a_held_track_not_freed_off_the_plateau_restarts_there() {
+    horizon_within("held_unfreed", 1.01, 1.110_196e6);
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP

@@ -39,6 +39,13 @@
 //! The edge now steps further off, by the band and doubling
 //! ([`FREE_STEPS`] tail flights at most), until the held track is freed:
 //! 1.0027×; `unseen_1706_7` (`second`, the same shape) 3.22× → 1.0025×.
+//! Where no step frees it, the point just off the edge is still a start
+//! if it is as feasible as the plateau: on `check_planner.py --seed 2005
+//! --vehicle tools/reference/vehicles/rate.toml` (`unseen_2005_5`) `z_3`
+//! shallower off its plateau lowers track 4, held by `z_2`, but there the
+//! linearization sees `z_3` take over holding track 4, and `z_2` moves
+//! 87 m deeper: 3.40× → 1.0002×. (Off Monterey 1's plateau the point is
+//! 5 m short: no restart.)
 
 use crate::num::max;
 use crate::optim::Bounds;
@@ -180,8 +187,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// returned, with its `J` as its score: the restart is kept only if it
     /// ends lower. A later track held (`later`) must be freed there by
     /// more than the slack; else the point steps further off, by the band
-    /// and doubling, [`FREE_STEPS`] times at most (module docs). `None`
-    /// when track `j` is not held, or the later track is not freed.
+    /// and doubling, [`FREE_STEPS`] times at most (module docs); not
+    /// freed, the point just off the edge if it is as feasible as the
+    /// plateau (within the slack). `None` when track `j` is not held, or
+    /// the later track is neither freed nor the edge's point feasible.
     fn held_edge(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -223,7 +232,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
             step = if step == 0.0 { away } else { 2.0 * step };
         }
-        None
+        // Not freed, but as feasible as the plateau (within the slack):
+        // the linearization there sees `z_j`, which may take over holding
+        // track `g` from the depths before it and let them move.
+        (off.2 <= on.2 + slack).then_some(((0.0, off.1), with_depth(z, j, off.0)))
     }
 
     /// A cold horizon's last escape: [`Planner::held_edge`] for a track
