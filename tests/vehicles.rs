@@ -251,6 +251,20 @@ fn a_held_track_not_freed_off_the_plateau_restarts_there() {
     horizon_within("held_unfreed", 1.01, 1.110_196e6);
 }
 
+/// A plateau past a ridge (`check_planner.py --seed 2006 --vehicle
+/// tools/reference/vehicles/second.toml`, `unseen_2006_6`, track 1,
+/// unconstrained): `J` is flat deeper than about 1 210 m, rises off the
+/// plateau's edge and falls past that ridge to the optimum. The restart
+/// from the edge slid back onto the plateau: 1 278.25 m, `J` 148 979 m³,
+/// 1.11× the f64 best 134 234 m³ (1 140.27 m). Now from a point past the
+/// ridge below the plateau.
+#[test]
+fn a_plateau_past_a_ridge_is_left() {
+    let t = &tracks_of("ridge_plateau", &UNCONSTRAINED, &[])[0];
+    let j = t["J"].as_f64().unwrap();
+    assert!(j <= 1.005 * 134_234.0, "track 1: J {j} vs the best");
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP
