@@ -265,6 +265,20 @@ fn a_plateau_past_a_ridge_is_left() {
     assert!(j <= 1.005 * 134_234.0, "track 1: J {j} vs the best");
 }
 
+/// A freed start whose `J` is above the SQP's (`check_planner.py --seed
+/// 2006 --vehicle tools/reference/vehicles/second.toml`, `unseen_2006_5`):
+/// the cold SQP ended with track 3 held at its target by track 2's depth;
+/// lifting track 2 by 160 m freed it, but the start (track 3 deepened by
+/// the 2.5 m freed beyond the band) had a horizon `J` of 5.33e6 m³
+/// against the SQP's 4.48e6 m³ and was not tried. Restarted from it, the
+/// SQP flies track 2 101 m shallower and track 3 81 m deeper. The line's
+/// `J` was 4.48471e6 m³, 1.32× the f64 beam search's best safe plan
+/// (3.403426e6 m³); now 0.991×.
+#[test]
+fn a_freed_start_is_tried_whatever_its_j() {
+    horizon_within("lift_freed_higher", 1.01, 3.403_426e6);
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP
