@@ -279,6 +279,18 @@ fn a_freed_start_is_tried_whatever_its_j() {
     horizon_within("lift_freed_higher", 1.01, 3.403_426e6);
 }
 
+/// A freed held edge ranked before an unfreed one (`check_planner.py
+/// --seed 2004`, `unseen_2004_6`, default vehicle). The cold call's last
+/// escape had two plateau edges: off track 2's, track 3 freed; off track
+/// 4's, track 5 not freed, the point's `J` a little lower. Taking the
+/// lower `J` restarted from the unfreed one, which gained nothing, and the
+/// freed one was never tried: the line's `J` 6.48653e7 m³, 1.35× the f64
+/// beam search's best safe plan (4.798282e7 m³); ranked, 1.081×.
+#[test]
+fn a_freed_held_edge_is_ranked_before_an_unfreed_one() {
+    horizon_within("held_ranked", 1.10, 4.798_282e7);
+}
+
 /// A restoring plateau scan that took a saturated climb's shallowest point
 /// (`check_planner.py --seed 1705 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_1705_2`): the cold SQP

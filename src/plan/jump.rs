@@ -234,8 +234,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         // Not freed, but as feasible as the plateau (within the slack):
         // the linearization there sees `z_j`, which may take over holding
-        // track `g` from the depths before it and let them move.
-        (off.2 <= on.2 + slack).then_some(((0.0, off.1), with_depth(z, j, off.0)))
+        // track `g` from the depths before it and let them move. Ranked
+        // after any freed start (its score's first entry above 0).
+        let unfreed = (f32::MIN_POSITIVE, off.1);
+        (off.2 <= on.2 + slack).then_some((unfreed, with_depth(z, j, off.0)))
     }
 
     /// A cold horizon's last escape: [`Planner::held_edge`] for a track
