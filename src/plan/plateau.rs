@@ -164,6 +164,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !(j < flat && at.score.min_altitude() >= h_safe) {
             return false;
         }
+        if let Some(z) = self.work.z.first_mut() {
+            *z = at.depth;
+        }
         if !self.polish_boundary(obj, bounds, (at.depth, j)) {
             self.work.j = j;
             let _ = self.work.history.push(j);
@@ -222,10 +225,12 @@ fn plateau_edge<const N: usize, const K: usize>(
             break;
         }
         let t = min(max(out + dir * step, lo), hi);
-        if value_at(t)? < flat {
-            return Some(t);
+        // (A failed probe keeps the edge found.)
+        match value_at(t) {
+            Some(v) if v < flat => return Some(t),
+            Some(_) => step *= 2.0,
+            None => break,
         }
-        step *= 2.0;
     }
     Some(out)
 }
