@@ -49,6 +49,24 @@ fn a_corner_near_the_unsafe_end_is_reached() {
     assert!(j2 <= 1.005 * 4.807_87e6, "track 2: J {j2} vs the best safe");
 }
 
+/// The same flat side, its unsafe side sloped at 0.08 m of altitude a
+/// metre of depth (`check_planner.py --seed 2101`, `unseen_2101_3`,
+/// default vehicle): unit steps from the unsafe end, which assume a slope
+/// of 1, crawled a quarter of a metre each and the search ran out of
+/// steps at a safe end 61 m short. Track 4 answered 437.71 m, `J`
+/// 3.83215e7 m³, 1.476× the f64 best safe 2.59700e7 m³ (498.641 m, from
+/// the state the tool's tracks 1 to 3 leave). Now the secant of two
+/// unsafe evaluations.
+#[test]
+fn a_shallow_unsafe_slope_is_crossed_by_its_secant() {
+    let premise = [(0, 397.033), (1, 669.723), (2, 491.758)];
+    let tracks = tracks_of("flat_boundary", &["--mode", "track"], &premise);
+    let t4 = &tracks[3];
+    let j4 = t4["J"].as_f64().unwrap();
+    assert_eq!(t4["safe"], true, "{t4}");
+    assert!(j4 <= 1.005 * 2.597_00e7, "track 4: J {j4} vs the best safe");
+}
+
 /// The safe mode with a one-track horizon (its continuation certified to
 /// the line's end) on the shared profiles, against the best safe `J` of
 /// the f64 exhaustive search (`scripts/j_gap.py`, BENCHMARKS.md "J

@@ -18,7 +18,8 @@
 //! whatever margin the previous track's boundary left it): a caller's safe
 //! end there, or a safe evaluation at the same margin, may lie anywhere on
 //! that side, so the search goes on, by the unit step where it lands
-//! inside the bracket, else by bisection.
+//! inside the bracket, else by bisection; where two unsafe evaluations
+//! have measured the unsafe side's slope, by their secant instead.
 
 /// How far towards the unsafe end (of the bracket) a secant may land. A
 /// wide bracket whose boundary lies near its unsafe end (a long flat safe
@@ -101,20 +102,26 @@ impl Search {
         // tolerance (the hinge's sloped side falls at unit slope).
         let unit = -g_bad + 0.5 * tol;
         let t_unit = (g_bad < 0.0 && unit < width).then(|| 1.0 - unit / width);
-        if self.flat && self.margin <= tol {
-            // Probing a flat safe side: the unit step lands on the
-            // boundary if the unsafe end is on the sloped side.
-            return match t_unit {
-                Some(tu) if tu > 0.01 && tu < 0.999 => (tu, true),
-                _ => (0.5, false),
-            };
-        }
         let aim = |z: f32| (z - good) / (bad - good);
         // The secant, when it has two distinct margins and lands inside.
         let secant = self.latest.and_then(|((z1, g1), (z2, g2))| {
             let ts = aim(z1 + (0.5 * tol - g1) * (z1 - z2) / (g1 - g2));
             (libm::fabsf(g1 - g2) > 0.0 && ts > 0.01 && ts < SECANT_REACH).then_some(ts)
         });
+        if self.flat && self.margin <= tol {
+            // Probing a flat safe side: the unit step lands on the
+            // boundary if the unsafe end is on the sloped side; where two
+            // unsafe evaluations measured that side's slope, their secant
+            // (unit steps on a slope of 0.08 crawled: `unseen_2101_3`).
+            let both_bad = self
+                .latest
+                .is_some_and(|((_, g1), (_, g2))| g1 < 0.0 && g2 < 0.0);
+            return match (secant.filter(|_| both_bad), t_unit) {
+                (Some(ts), _) => (ts, false),
+                (None, Some(tu)) if tu > 0.01 && tu < 0.999 => (tu, true),
+                _ => (0.5, false),
+            };
+        }
         // First, and whenever the newest evaluation was unsafe and gave no
         // usable secant: the unit step; but where the two latest were
         // unsafe at the same margin the unsafe side is flat (the least
