@@ -86,7 +86,7 @@ const SECANT_REACH: f32 = 4.0;
 
 /// An accepted step below this share of the QP's is a sliver
 /// ([`SqpEnd::sliver`]).
-pub(crate) const SLIVER: f32 = 1e-3;
+const SLIVER: f32 = 1e-3;
 
 /// Infeasible iterations in a row that leave the merit `φ` unmoved (within
 /// the relative tolerance) before the run counts as stalled: on an

@@ -153,15 +153,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         // The start whose horizon `J` is lowest: a freed one (feasible
         // within the band) up to a share above the SQP's, a deep one below.
+        let (sqp, loose) = (self.work.j, (1.0 + FREED_SHARE) * self.work.j);
+        let starts = [
+            (freed, band, loose),
+            (deeper, band, loose),
+            (deep, f32::INFINITY, sqp),
+        ];
         let mut best: Option<([f32; K], f32)> = None;
-        for (start, most) in [(freed, band), (deeper, band), (deep, f32::INFINITY)] {
+        for (start, most, bar) in starts {
             let Some(start) = start else { continue };
             let (jz, v) = obj.tail_value(&head, (&at_j, j), &start)?;
-            let bar = if most.is_finite() {
-                (1.0 + FREED_SHARE) * self.work.j
-            } else {
-                self.work.j
-            };
             if v <= most && jz < best.map_or(bar, |(_, b)| b.min(bar)) {
                 best = Some((start, jz));
             }

@@ -164,11 +164,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !(j < flat && at.score.min_altitude() >= h_safe) {
             return false;
         }
-        if let Some(z) = self.work.z.first_mut() {
-            *z = at.depth;
-        }
         if !self.polish_boundary(obj, bounds, (at.depth, j)) {
-            self.work.j = j;
+            // (At the boundary: its value ends the history.)
             let _ = self.work.history.push(j);
         }
         true

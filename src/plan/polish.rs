@@ -86,20 +86,22 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The polish's search from a constrained track's boundary `(z, J)`
     /// (m, m³), in `bounds`, every point's least altitude at or above the
-    /// objective's guard (its trip cleared): whether it found a lower `J`
-    /// (the workspace then there).
+    /// objective's guard (its trip cleared): the workspace put at the
+    /// boundary, then moved to the lower `J` if one is found (whether it
+    /// was).
     pub(super) fn polish_boundary(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         bounds: &Bounds<K>,
         (z, j): (f32, f32),
     ) -> bool {
-        let (Some(&lo), Some(&hi)) = (bounds.lo.first(), bounds.hi.first()) else {
-            return false;
-        };
         if let Some(first) = self.work.z.first_mut() {
             *first = z;
         }
+        self.work.j = j;
+        let (Some(&lo), Some(&hi)) = (bounds.lo.first(), bounds.hi.first()) else {
+            return false;
+        };
         obj.tripped = None;
         let guard = obj.guard;
         self.polish_from(obj, (lo, hi), guard, (z, j))
