@@ -8,8 +8,6 @@ import sys
 
 ALLOWED = {
     # name: why (keep in step with ARCHITECTURE.md's exceptions)
-    "fast_run": "the simulation's hot loop, kept whole: split, it cost 7-12 "
-    "M4F instructions per step in register moves (measured)",
 }
 FN = re.compile(r"^(\s*)(pub(\([a-z]+\))? )?(const )?fn (\w+)")
 bad = []

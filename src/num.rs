@@ -127,6 +127,11 @@ pub(crate) fn sin_cos_long(x: f32) -> (f32, f32) {
 /// Where [`sin_cos_short`] applies: `|x| <= π/4` (45°).
 pub(crate) const SHORT: f32 = core::f32::consts::FRAC_PI_4;
 
+/// `SHORT²` rounded: `x * x <= SHORT_SQ` exactly where `|x| <= SHORT`
+/// (and not for NaN), since f32 squaring is monotonic and the squares of
+/// `SHORT` and of the next f32 round apart (tested).
+pub(crate) const SHORT_SQ: f32 = SHORT * SHORT;
+
 /// `(sin x, cos x)` for `|x| <= π/4` (radians; not checked): the degree-7
 /// and degree-8 polynomials of [`sin_cos`] (their own error below 3e-9).
 #[inline(always)]
@@ -332,6 +337,23 @@ mod tests {
         assert!(s.is_nan() && c.is_nan());
         let (s, c) = sin_cos(f32::NAN);
         assert!(s.is_nan() && c.is_nan());
+    }
+
+    #[test]
+    fn the_square_decides_short_exactly() {
+        // Both sides of the limit, a few ulps out, both signs.
+        let mut x = SHORT;
+        for _ in 0..8 {
+            x = f32::from_bits(x.to_bits() - 1);
+        }
+        for _ in 0..17 {
+            for v in [x, -x] {
+                assert_eq!(v * v <= SHORT_SQ, v.abs() <= SHORT, "{v}");
+            }
+            x = f32::from_bits(x.to_bits() + 1);
+        }
+        let nan = core::hint::black_box(f32::NAN);
+        assert_eq!((nan * nan).partial_cmp(&SHORT_SQ), None);
     }
 
     #[test]

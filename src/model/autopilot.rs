@@ -261,6 +261,11 @@ impl Autopilot {
         // The depth loop's output is `−(…)`: the error pushing it up is `−e_d`.
         let depth_out = saturate(v, self.cfg.pitch_limit, -e_d);
         let pitch_ref = depth_out.value;
+        // (The pitch loop does not read `I_d`: updating it here, where the
+        // depth loop decides it, is the contract's order to the bit.)
+        if depth_out.integrating {
+            *depth_integral += self.sample_time * e_d;
+        }
 
         let e_t = pitch_ref - pitch;
         let g = &self.signed_pitch;
@@ -274,9 +279,6 @@ impl Autopilot {
         // `σ e_θ`.
         let pitch_out = saturate(w, self.cfg.elevator_limit, self.sign * e_t);
         let elevator = pitch_out.value;
-        if depth_out.integrating {
-            *depth_integral += self.sample_time * e_d;
-        }
         if pitch_out.integrating {
             *pitch_integral += self.sample_time * e_t;
         }
@@ -293,22 +295,6 @@ impl Autopilot {
     }
 }
 
-/// A loop's output `u` clamped to `±limit`, whether the clamp is inactive,
-/// and whether its integrator
-/// integrates (conditional integration, contract §7): it holds only while
-/// the output is saturated and integrating would drive it further out,
-/// that is on `u > limit` with `push > 0` or on `u < −limit` with
-/// `push < 0`, where `push` is the loop's error signed as it pushes the
-/// output up. With the clamp's excess `u − clamp(u)` (zero inside the
-/// limits, of the sign of `u` outside) that is `(u − clamp(u)) push > 0`:
-/// one product and compare.
-///
-/// Inside the limits, the common case, the clamp is the identity and the
-/// excess zero, so the integrator integrates: the one compare of `|u|`
-/// decides it and the rest stays out of the way. (NaN takes the general
-/// branch: NaN out, no integration. An infinite `push` makes the loop's
-/// proportional term, and so `u`, infinite or NaN: the general branch
-/// too, as in the general form.)
 /// What [`saturate`] gives: the clamped output and the two flags.
 #[derive(Clone, Copy)]
 struct Saturated {
@@ -320,6 +306,19 @@ struct Saturated {
     integrating: bool,
 }
 
+/// A loop's output `u` clamped to `±limit`, whether the clamp is inactive,
+/// and whether its integrator
+/// integrates (conditional integration, contract §7): it holds only while
+/// the output is saturated and integrating would drive it further out,
+/// that is on `u > limit` with `push > 0` or on `u < −limit` with
+/// `push < 0`, where `push` is the loop's error signed as it pushes the
+/// output up.
+///
+/// Inside the limits, the common case, the clamp is the identity and the
+/// integrator integrates: the one compare of `|u|` decides it. Outside,
+/// the side of the limit the output is on gives the clamp, and the sign
+/// of `push` the integrator (no product, which could underflow to zero).
+/// NaN: NaN out, no integration.
 #[inline(always)]
 fn saturate(u: f32, limit: f32, push: f32) -> Saturated {
     if libm::fabsf(u) <= limit {
@@ -328,12 +327,24 @@ fn saturate(u: f32, limit: f32, push: f32) -> Saturated {
             linear: true,
             integrating: true,
         }
-    } else {
-        let c = clamp(u, limit);
+    } else if u > limit {
         Saturated {
-            value: c,
+            value: limit,
             linear: false,
-            integrating: (u - c) * push <= 0.0,
+            integrating: push <= 0.0,
+        }
+    } else if u < -limit {
+        Saturated {
+            value: -limit,
+            linear: false,
+            integrating: push >= 0.0,
+        }
+    } else {
+        // NaN: NaN out, no integration.
+        Saturated {
+            value: u,
+            linear: false,
+            integrating: false,
         }
     }
 }
@@ -347,12 +358,11 @@ mod tests {
     }
 
     #[test]
-    fn saturate_is_the_clamp_and_the_excess_test() {
-        // The one-compare fast branch must agree with the general form,
-        // `(clamp(u), (u − clamp(u)) push <= 0)` for every `u` (zeros, the
-        // limit itself, infinities and NaN) and every finite `push`. (An
-        // infinite error makes the loop's proportional term, and so `u`,
-        // infinite or NaN: the general branch.)
+    fn saturate_is_the_clamp_and_the_contracts_integration_rule() {
+        // The branches must agree with the contract's form, `clamp(u)` and
+        // "integrate unless u > limit with push > 0 or u < −limit with
+        // push < 0" (no integration for NaN), for every `u` (zeros, the
+        // limit itself, infinities and NaN) and every finite `push`.
         let vals = [
             0.0,
             -0.0,
@@ -376,7 +386,8 @@ mod tests {
             for &push in vals.iter().filter(|p| p.is_finite()) {
                 for limit in [15.0, 1e-3, f32::MAX] {
                     let c = clamp(u, limit);
-                    let general = (c, (u - c) * push <= 0.0);
+                    let held = (u > limit && push > 0.0) || (u < -limit && push < 0.0);
+                    let general = (c, !u.is_nan() && !held);
                     let fast = saturate(u, limit, push);
                     assert_eq!(
                         fast.value.to_bits(),

@@ -50,6 +50,10 @@ pub(crate) struct PieceLin {
 
 /// Receives the linearization of a run as it happens.
 pub(crate) trait Sensitivity<const N: usize> {
+    /// Whether the fast path's loop takes two steps a pass (see
+    /// `Scenario::fast_run`): for a loop small enough that the register
+    /// copies it saves outweigh the flash of a second copy.
+    const TWO_STEPS: bool = false;
     /// After step `k` has moved the state to sample `k + 1`.
     fn step(&mut self, vehicle: &Vehicle<N>, lin: &StepLin);
     /// After a piece of the newest segment was scored into track `slot`.
@@ -69,6 +73,7 @@ pub(crate) trait Sensitivity<const N: usize> {
 pub(crate) struct NoSensitivity;
 
 impl<const N: usize> Sensitivity<N> for NoSensitivity {
+    const TWO_STEPS: bool = true;
     #[inline(always)]
     fn step(&mut self, _: &Vehicle<N>, _: &StepLin) {}
     #[inline(always)]

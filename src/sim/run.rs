@@ -37,7 +37,11 @@ struct Flight<const N: usize> {
     pitch: f32,
     /// `d_k − d_{k−1}`, m.
     rise: f32,
-    /// Steps left before the run is declared stuck.
+    /// Steps left before the run is declared stuck. Every step of the
+    /// general path counts, and every steep one (`|θ̄| > 45°`) of the fast
+    /// path: a fast step within ±45° moves `x` on by at least `U0 Ts cos
+    /// 45°`, and a fast run ends within `FAST_RUN` steps' length, so that
+    /// the fast path cannot be stuck.
     budget: u32,
     cursor: Cursor,
     /// The current sample's geometry.
@@ -47,6 +51,40 @@ struct Flight<const N: usize> {
     track_end: f32,
     /// Where the run ends, m.
     x_end: f32,
+}
+
+/// The fast path's state from step to step (see `Scenario::fast_run`):
+/// the flight's, in locals, and the track's running score.
+struct FastRun<const N: usize> {
+    st: VehicleState<N>,
+    pitch: f32,
+    rise: f32,
+    budget: u32,
+    /// The last sample; its `p` is `p0`.
+    a0: At,
+    /// The last sample's shortfall `p`, m: set where it is computed, and 0
+    /// on every sample the common case passes (it is at or above `h_p`).
+    p0: f32,
+    /// The last sample's `e²`, m².
+    e2: f32,
+    /// No sample at or above it sets a new minimum or violates, m.
+    guard: f32,
+    acc: TrackScore,
+    /// The run's plain sum of trapezoids (times 4), m³.
+    j_run: f32,
+}
+
+/// What the fast path's steps share: the reference `r` (m), the active
+/// track and its score slot, the bottom segment, where the fast path ends
+/// (m), and `h_r`, `h_p` (m).
+struct OnSegment {
+    r: f32,
+    track: usize,
+    slot: usize,
+    cursor: Cursor,
+    fast_limit: f32,
+    h_r: f32,
+    h_p: f32,
 }
 
 /// The end of a run: finite scores and a finite end state, or
@@ -279,112 +317,147 @@ impl<const N: usize> Scenario<'_, N> {
     fn fast_run<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
         &self,
         fl: &mut Flight<N>,
-        mut a0: At,
+        a0: At,
         r: f32,
         slot: usize,
         score: &mut TrackScore,
         sens: &mut Sn,
         observe: &mut F,
     ) -> Result<(), SimError> {
-        let (h_r, h_p) = (self.mission.reference_altitude(), self.penalty_altitude);
+        let h_p = self.penalty_altitude;
         // A run is also cut after about `FAST_RUN` steps, so that its plain
         // partial sum of `J` (added to the track's compensated sum when the
         // run ends) adds up at most that many terms: relative error below
         // `FAST_RUN` ε/2.
         let horizon = fl.st.x.value() + FAST_RUN * self.kin.step;
         let event = min(min(fl.track_end, fl.cursor.end()), horizon);
-        let fast_limit = event - (1e-3 + 4.0 * f32::EPSILON * libm::fabsf(event));
-        let mut acc = *score;
-        let mut j_run = 0.0_f32;
-        let mut e2 = a0.e * a0.e;
-        let mut guard = if a0.p > 0.0 {
-            f32::INFINITY
-        } else {
-            max(acc.min_altitude, h_p)
+        let on = OnSegment {
+            r,
+            track: fl.track,
+            slot,
+            cursor: fl.cursor,
+            fast_limit: event - (1e-3 + 4.0 * f32::EPSILON * libm::fabsf(event)),
+            h_r: self.mission.reference_altitude(),
+            h_p,
         };
-        let mut fast = false;
         // The flight's state in locals, for registers in the loop.
-        let (mut st, mut pitch, mut rise, mut budget) = (fl.st, fl.pitch, fl.rise, fl.budget);
-        let (cursor, track) = (fl.cursor, fl.track);
+        let mut run = FastRun {
+            st: fl.st,
+            pitch: fl.pitch,
+            rise: fl.rise,
+            budget: fl.budget,
+            a0,
+            p0: a0.p,
+            e2: a0.e * a0.e,
+            guard: if a0.p > 0.0 {
+                f32::INFINITY
+            } else {
+                max(score.min_altitude, h_p)
+            },
+            acc: *score,
+            j_run: 0.0,
+        };
         loop {
-            // On an error the run is lost, but its score so far is kept.
-            let Some(left) = budget.checked_sub(1) else {
-                acc.j.add(0.25 * j_run);
-                *score = acc;
-                return Err(SimError::StepLimit);
-            };
-            budget = left;
-            let at = (&mut st, &mut pitch, &mut rise);
-            let (dx, dd, lin) = match self.step_alone(at, (r, track, slot), observe) {
-                Ok(v) => v,
-                Err(e) => {
-                    acc.j.add(0.25 * j_run);
-                    *score = acc;
-                    return Err(e);
-                }
-            };
-            // (NaN leaves the fast path too.)
-            if st.x.value().partial_cmp(&fast_limit) != Some(core::cmp::Ordering::Less) {
-                // The general path scores this step.
-                sens.step(self.vehicle, &lin);
+            if !self.fast_step(&mut run, &on, score, sens, observe)? {
                 break;
             }
-            fast = true;
-            // Δx and Δd are the step's exact increments; the new sample is
-            // on the cursor's segment: no lookup.
-            let p1 = cursor.point(st.x);
-            // `p` is computed only where the sample can matter (below).
-            let mut a1 = At::clear(p1.altitude(st.depth), p1.slope, h_r);
-            let e2_next = a1.e * a1.e;
-            // (The trapezoid's ¼ is applied to the run's sum: a power of
-            // two, so exactly the same.)
-            j_run += trapezoid(dx, e2, e2_next);
-            // One compare in the common case: a sample at or above `guard`
-            // sets no new minimum and does not violate, and `guard` is +inf
-            // after a violating sample, so that the violation's next
-            // trapezoid is taken here too.
-            if a1
-                .h
-                .partial_cmp(&guard)
-                .is_none_or(|o| o == core::cmp::Ordering::Less)
-            {
-                a1.p = shortfall(a1.h, h_p);
-                if a0.p > 0.0 || a1.p > 0.0 {
-                    acc.violation
-                        .add(0.25 * trapezoid(dx, a0.p * a0.p, a1.p * a1.p));
-                }
-                // The segment's first sample was counted as the last one's
-                // end.
-                acc.min_altitude = min(acc.min_altitude, a1.h);
-                guard = if a1.p > 0.0 {
-                    f32::INFINITY
-                } else {
-                    max(acc.min_altitude, h_p)
-                };
+            // The plain flight takes two steps a pass: the state's old and
+            // new values swap registers from one step to the next, instead
+            // of being copied back (about 10 instructions a step on a
+            // Cortex-M4F).
+            if Sn::TWO_STEPS && !self.fast_step(&mut run, &on, score, sens, observe)? {
+                break;
             }
-            let ends = ((&a0, st.x_prev.value()), (&a1, st.x.value()));
-            sens.step_piece(
-                self.vehicle,
-                &lin,
-                slot,
-                &piece_within(dx, dd, ends.0, ends.1),
-            );
-            e2 = e2_next;
-            a0 = a1;
         }
-        acc.j.add(0.25 * j_run);
-        *score = acc;
-        (fl.st, fl.pitch, fl.rise, fl.budget) = (st, pitch, rise, budget);
-        if fast {
-            // The sample before the one that left the fast path.
-            fl.cur = Geo {
-                x: fl.st.x_prev,
-                d: fl.st.depth_prev,
-                at: Some(a0),
-                past: -1.0,
-            };
-        }
+        run.acc.j.add(0.25 * run.j_run);
+        *score = run.acc;
+        (fl.st, fl.pitch, fl.rise, fl.budget) = (run.st, run.pitch, run.rise, run.budget);
+        // The sample before the one that left the fast path (where that
+        // was the first step, the sample `fl.cur` already held).
+        fl.cur = Geo {
+            x: fl.st.x_prev,
+            d: fl.st.depth_prev,
+            at: Some(At {
+                p: run.p0,
+                ..run.a0
+            }),
+            past: -1.0,
+        };
         Ok(())
+    }
+
+    /// One step of the fast path (see [`Scenario::fast_run`]): `Ok(true)`
+    /// where the new sample stays on it, scored; `Ok(false)` where it
+    /// leaves it, for the general path to score.
+    #[inline(always)]
+    fn fast_step<Sn: Sensitivity<N>, F: FnMut(&Sample)>(
+        &self,
+        run: &mut FastRun<N>,
+        on: &OnSegment,
+        score: &mut TrackScore,
+        sens: &mut Sn,
+        observe: &mut F,
+    ) -> Result<bool, SimError> {
+        let at = (&mut run.st, &mut run.pitch, &mut run.rise);
+        let steep = Some(&mut run.budget);
+        let (dx, dd, lin) = match self.step_alone(at, (on.r, on.track, on.slot), steep, observe) {
+            Ok(v) => v,
+            Err(e) => {
+                // The run is lost, but its score so far is kept.
+                run.acc.j.add(0.25 * run.j_run);
+                *score = run.acc;
+                return Err(e);
+            }
+        };
+        let st = &run.st;
+        // (NaN leaves the fast path too.)
+        if st.x.value().partial_cmp(&on.fast_limit) != Some(core::cmp::Ordering::Less) {
+            // The general path scores this step.
+            sens.step(self.vehicle, &lin);
+            return Ok(false);
+        }
+        // Δx and Δd are the step's exact increments; the new sample is on
+        // the cursor's segment: no lookup.
+        let p1 = on.cursor.point(st.x);
+        // `p` is computed only where the sample can matter (below): the
+        // last sample's is `run.p0` (`run.a0.p` is not kept up).
+        let mut a1 = At::clear(p1.altitude(st.depth), p1.slope, on.h_r);
+        let e2_next = a1.e * a1.e;
+        // (The trapezoid's ¼ is applied to the run's sum: a power of two,
+        // so exactly the same.)
+        run.j_run += trapezoid(dx, run.e2, e2_next);
+        let p0 = run.p0;
+        // One compare in the common case: a sample at or above `guard` sets
+        // no new minimum and does not violate (its `p` is 0), and `guard`
+        // is +inf after a violating sample, so that the violation's next
+        // trapezoid is taken here too.
+        if a1
+            .h
+            .partial_cmp(&run.guard)
+            .is_none_or(|o| o == core::cmp::Ordering::Less)
+        {
+            a1.p = shortfall(a1.h, on.h_p);
+            let acc = &mut run.acc;
+            if p0 > 0.0 || a1.p > 0.0 {
+                acc.violation
+                    .add(0.25 * trapezoid(dx, p0 * p0, a1.p * a1.p));
+            }
+            // The segment's first sample was counted as the last one's end.
+            acc.min_altitude = min(acc.min_altitude, a1.h);
+            run.guard = if a1.p > 0.0 {
+                f32::INFINITY
+            } else {
+                max(acc.min_altitude, on.h_p)
+            };
+            run.p0 = a1.p;
+        }
+        let a0 = At { p: p0, ..run.a0 };
+        let ends = ((&a0, st.x_prev.value()), (&a1, st.x.value()));
+        let piece = piece_within(dx, dd, ends.0, ends.1);
+        sens.step_piece(self.vehicle, &lin, on.slot, &piece);
+        run.e2 = e2_next;
+        run.a0 = a1;
+        Ok(true)
     }
 
     /// Whether `start` can start a run on track `first`: finite, and at
@@ -425,23 +498,29 @@ impl<const N: usize> Scenario<'_, N> {
         sens: &mut Sn,
         observe: &mut F,
     ) -> Result<(f32, f32), SimError> {
-        let (dx, dd, lin) = self.step_alone(at, ref_track_slot, observe)?;
+        let (dx, dd, lin) = self.step_alone(at, ref_track_slot, None, observe)?;
         sens.step(self.vehicle, &lin);
         Ok((dx, dd))
     }
 
     /// [`Scenario::advance`] without handing the linearization on: it is
     /// returned with the increments, for the fast path to hand on with
-    /// the step's piece.
+    /// the step's piece. A steep step (`|θ̄| > 45°`) takes one off
+    /// `steep_budget` where there is one (the fast path's: see
+    /// `Flight::budget`), or fails with [`SimError::StepLimit`] where it is
+    /// spent.
     #[inline(always)]
     fn step_alone<F: FnMut(&Sample)>(
         &self,
         (st, pitch, rise): (&mut VehicleState<N>, &mut f32, &mut f32),
         (r, track, slot): (f32, usize, usize),
+        steep_budget: Option<&mut u32>,
         observe: &mut F,
     ) -> Result<(f32, f32, StepLin), SimError> {
         let plant = self.vehicle.plant();
-        let ts = plant.sample_time();
+        // (The autopilot's `Ts`, the vehicle's as the plant's is, which the
+        // integrators use too: one value in one register.)
+        let ts = self.vehicle.autopilot().sample_time();
         let pitch_rate = plant.pitch_rate_v(&st.eta);
         let e_d = -st.depth.minus(r);
         // `d_k − d_{k−1}` is the last step's `Δd`: `depth` was `depth_prev`
@@ -469,10 +548,15 @@ impl<const N: usize> Scenario<'_, N> {
         // A cruising vehicle's mean pitch is within ±45°: the short
         // polynomials, whose results are finite with `cos > 0`. Beyond (or
         // NaN, from a diverging loop), the checked general case.
-        let abs = libm::fabsf(mean);
-        let (sin, cos) = if abs <= crate::num::SHORT {
+        // (`mean²`, which the polynomials need anyway, decides it: see
+        // `SHORT_SQ`.)
+        let (sin, cos) = if mean * mean <= crate::num::SHORT_SQ {
             crate::num::sin_cos_short(mean)
         } else {
+            let abs = libm::fabsf(mean);
+            if let Some(b) = steep_budget {
+                *b = b.checked_sub(1).ok_or(SimError::StepLimit)?;
+            }
             // Inline, not a call: a call in the loop would cost register
             // spills on every step.
             let (sin, cos) = crate::num::sin_cos_long(mean);
