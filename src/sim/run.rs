@@ -597,8 +597,30 @@ mod tests {
     //! differently), the same minimum altitude, and `J` and the violation
     //! equal to their summation's rounding.
     use super::*;
-    use crate::model::{Mission, Profile, Vehicle, Waypoints};
+    use crate::model::{Mission, Profile, TransferFunction, Vehicle, VehicleConfig, Waypoints};
     use crate::sim::rng::Lcg;
+
+    /// The stuck-run budget (`Flight::budget`) counts the fast path's steep
+    /// steps: a dive held at 80° to a reference far below, over a flat
+    /// bottom (one segment: the fast path all the way), moves on 2.6 cm a
+    /// step and runs out of its 4 steps per step-length of track; held at
+    /// 40° it arrives.
+    #[test]
+    fn a_steep_dive_spends_the_budget_and_a_shallow_one_does_not() {
+        let fly = |pitch_limit: f32| {
+            let mut cfg = VehicleConfig::default();
+            cfg.autopilot.pitch_limit = pitch_limit;
+            let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
+            let bottom = Profile::<2>::new(&[0.0, 400.0], &[9000.0, 9000.0]).unwrap();
+            let wps = Waypoints::<2>::new(&[0.0, 200.0]).unwrap();
+            let sc = Scenario::new(&vehicle, &bottom, &wps, Mission::default()).unwrap();
+            let start = sc.start_state(50.0);
+            let mut scores = [TrackScore::default(); 1];
+            sc.simulate(&start, 0, &[8000.0], &mut scores, |_| {})
+        };
+        assert_eq!(fly(80.0).err(), Some(SimError::StepLimit));
+        assert!(fly(40.0).is_ok());
+    }
 
     #[test]
     fn fast_path_equals_general_path_on_random_flights() {
