@@ -3,6 +3,8 @@
 
 use crate::model::{Command, Vehicle};
 
+use super::score::{At, piece_within};
+
 /// How the per-step cascade and kinematics linearize, for a tangent pass.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StepLin {
@@ -48,8 +50,31 @@ pub(crate) struct PieceLin {
     pub hi: End,
 }
 
+/// A piece of the fast path in parts: `Δx`, `Δd` (m) and its two
+/// samples with their `x` (m), both on one bottom segment inside the track.
+#[derive(Clone, Copy)]
+pub(super) struct FastPiece {
+    pub(super) dx: f32,
+    pub(super) dd: f32,
+    pub(super) lo: (At, f32),
+    pub(super) hi: (At, f32),
+}
+
+impl FastPiece {
+    /// The piece whole.
+    #[inline(always)]
+    pub(super) fn whole(&self) -> PieceLin {
+        piece_within(
+            self.dx,
+            self.dd,
+            (&self.lo.0, self.lo.1),
+            (&self.hi.0, self.hi.1),
+        )
+    }
+}
+
 /// Receives the linearization of a run as it happens.
-pub(crate) trait Sensitivity<const N: usize> {
+pub(super) trait Sensitivity<const N: usize> {
     /// Whether the fast path's loop takes two steps a pass (see
     /// `Scenario::fast_run`): for a loop small enough that the register
     /// copies it saves outweigh the flash of a second copy.
@@ -60,12 +85,14 @@ pub(crate) trait Sensitivity<const N: usize> {
     fn piece(&mut self, slot: usize, lin: &PieceLin);
     /// Step `k` and then the piece it flew, scored wholly into its own
     /// track `slot` (the fast path): as [`Sensitivity::step`] then
-    /// [`Sensitivity::piece`], which a tangent pass may do in one pass
-    /// over its columns.
+    /// [`Sensitivity::piece`] of the piece `(Δx, Δd)` from sample `lo` to
+    /// sample `hi` (each with its `x`, m; see `score::piece_within`), which
+    /// a tangent pass may do in one pass over its columns. (The piece comes
+    /// in parts, for a pass to build it only where it needs it whole.)
     #[inline(always)]
-    fn step_piece(&mut self, vehicle: &Vehicle<N>, lin: &StepLin, slot: usize, piece: &PieceLin) {
+    fn step_piece(&mut self, vehicle: &Vehicle<N>, lin: &StepLin, slot: usize, piece: FastPiece) {
         self.step(vehicle, lin);
-        self.piece(slot, piece);
+        self.piece(slot, &piece.whole());
     }
 }
 
@@ -79,5 +106,5 @@ impl<const N: usize> Sensitivity<N> for NoSensitivity {
     #[inline(always)]
     fn piece(&mut self, _: usize, _: &PieceLin) {}
     #[inline(always)]
-    fn step_piece(&mut self, _: &Vehicle<N>, _: &StepLin, _: usize, _: &PieceLin) {}
+    fn step_piece(&mut self, _: &Vehicle<N>, _: &StepLin, _: usize, _: FastPiece) {}
 }

@@ -36,7 +36,7 @@
 use crate::model::Vehicle;
 
 use super::column::{Column, Factors, Gains};
-use super::lin::{EndAt, PieceLin, Sensitivity, StepLin};
+use super::lin::{FastPiece, PieceLin, Sensitivity, StepLin};
 use super::watch::Watch;
 use super::{Scenario, SimError, TrackScore, VehicleState};
 
@@ -104,35 +104,31 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
     /// column's state is loaded once, and the piece's ends are the states
     /// before and after the step.
     #[inline(always)]
-    fn step_piece(&mut self, v: &Vehicle<N>, lin: &StepLin, slot: usize, p: &PieceLin) {
-        let (EndAt::Start { slope: s0 }, EndAt::End { slope: s1 }) = (p.lo.at, p.hi.at) else {
+    fn step_piece(&mut self, v: &Vehicle<N>, lin: &StepLin, slot: usize, q: FastPiece) {
+        let ((lo, x_lo), (hi, x_hi)) = (q.lo, q.hi);
+        if lo.p > 0.0 || hi.p > 0.0 {
             self.step(v, lin);
-            self.piece(slot, p);
-            return;
-        };
-        if p.lo.p > 0.0 || p.hi.p > 0.0 {
-            self.step(v, lin);
-            self.piece(slot, p);
+            self.piece(slot, &q.whole());
             return;
         }
         let f = self.factors(lin);
-        let sq_e = 0.25 * (p.lo.e * p.lo.e + p.hi.e * p.hi.e);
-        let half = 0.5 * p.len;
-        let (he_lo, he_hi) = (half * p.lo.e, half * p.hi.e);
-        let ends = ((s0, s1), (sq_e, he_lo, he_hi));
+        let sq_e = 0.25 * (lo.e * lo.e + hi.e * hi.e);
+        let half = 0.5 * q.dx;
+        let (he_lo, he_hi) = (half * lo.e, half * hi.e);
+        let ends = ((lo.slope, hi.slope), (sq_e, he_lo, he_hi));
         let n = lin.slot.saturating_add(1);
-        if self.watching && !self.watch.lower_recorded(p.lo.x) {
+        if self.watching && !self.watch.lower_recorded(x_lo) {
             let mut de = [(0.0, 0.0); K];
             for ((j, col), de) in self.cols.iter_mut().enumerate().zip(de.iter_mut()).take(n) {
                 *de = col.step_piece(&self.gains, &f, j == lin.slot, ends.0, ends.1);
             }
-            self.watch.piece(slot, p, &de);
+            self.watch.piece(slot, &q.whole(), &de);
             return;
         }
         // Watched, the lower end is recorded already: the upper end's
         // `∂e` is written only when it sets its segment's minimum.
         let row = if self.watching {
-            self.watch.upper(slot, (p.hi.x, p.hi.e))
+            self.watch.upper(slot, (x_hi, hi.e))
         } else {
             None
         };
