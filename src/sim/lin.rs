@@ -3,8 +3,6 @@
 
 use crate::model::{Command, Vehicle};
 
-use super::score::{At, piece_within};
-
 /// How the per-step cascade and kinematics linearize, for a tangent pass.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StepLin {
@@ -50,31 +48,34 @@ pub(crate) struct PieceLin {
     pub hi: End,
 }
 
-/// A piece of the fast path in parts: `Δx`, `Δd` (m) and its two
-/// samples with their `x` (m), both on one bottom segment inside the track.
+/// A piece of the fast path in parts: `Δx`, `Δd` (m) and its two ends,
+/// samples on one bottom segment inside the track (`lo` at its start,
+/// `hi` at its end), so that a pass reads the parts it needs and builds
+/// the piece whole only where it needs it.
 #[derive(Clone, Copy)]
-pub(super) struct FastPiece {
-    pub(super) dx: f32,
-    pub(super) dd: f32,
-    pub(super) lo: (At, f32),
-    pub(super) hi: (At, f32),
+pub(crate) struct FastPiece {
+    pub dx: f32,
+    pub dd: f32,
+    pub lo: End,
+    pub hi: End,
 }
 
 impl FastPiece {
-    /// The piece whole.
+    /// The piece whole (its length is its `Δx`).
     #[inline(always)]
-    pub(super) fn whole(&self) -> PieceLin {
-        piece_within(
-            self.dx,
-            self.dd,
-            (&self.lo.0, self.lo.1),
-            (&self.hi.0, self.hi.1),
-        )
+    pub fn whole(&self) -> PieceLin {
+        PieceLin {
+            len: self.dx,
+            dx: self.dx,
+            dd: self.dd,
+            lo: self.lo,
+            hi: self.hi,
+        }
     }
 }
 
 /// Receives the linearization of a run as it happens.
-pub(super) trait Sensitivity<const N: usize> {
+pub(crate) trait Sensitivity<const N: usize> {
     /// Whether the fast path's loop takes two steps a pass (see
     /// `Scenario::fast_run`): for a loop small enough that the register
     /// copies it saves outweigh the flash of a second copy.
@@ -85,10 +86,8 @@ pub(super) trait Sensitivity<const N: usize> {
     fn piece(&mut self, slot: usize, lin: &PieceLin);
     /// Step `k` and then the piece it flew, scored wholly into its own
     /// track `slot` (the fast path): as [`Sensitivity::step`] then
-    /// [`Sensitivity::piece`] of the piece `(Δx, Δd)` from sample `lo` to
-    /// sample `hi` (each with its `x`, m; see `score::piece_within`), which
-    /// a tangent pass may do in one pass over its columns. (The piece comes
-    /// in parts, for a pass to build it only where it needs it whole.)
+    /// [`Sensitivity::piece`] (of the piece whole), which a tangent pass
+    /// may do in one pass over its columns.
     #[inline(always)]
     fn step_piece(&mut self, vehicle: &Vehicle<N>, lin: &StepLin, slot: usize, piece: FastPiece) {
         self.step(vehicle, lin);

@@ -23,8 +23,8 @@
 use crate::model::Cursor;
 use crate::num::{DEG, max, min};
 
-use super::lin::{FastPiece, NoSensitivity, Sensitivity, StepLin};
-use super::score::{At, Geo, shortfall, trapezoid};
+use super::lin::{NoSensitivity, Sensitivity, StepLin};
+use super::score::{At, Geo, piece_within, shortfall, trapezoid};
 use super::{Sample, Scenario, SimError, TrackScore, VehicleState};
 
 /// Most steps of one run of the simulation's fast path (see `run`).
@@ -161,7 +161,7 @@ impl<const N: usize> Scenario<'_, N> {
     /// in-segment fast path (always, but for the test that compares the
     /// two paths).
     #[inline(always)]
-    pub(super) fn run<Sn: Sensitivity<N>, F: FnMut(&Sample), const FAST: bool>(
+    pub(crate) fn run<Sn: Sensitivity<N>, F: FnMut(&Sample), const FAST: bool>(
         &self,
         start: &VehicleState<N>,
         first: usize,
@@ -451,13 +451,14 @@ impl<const N: usize> Scenario<'_, N> {
             };
             run.p0 = a1.p;
         }
-        let piece = FastPiece {
-            dx,
-            dd,
-            lo: (At { p: p0, ..run.a0 }, st.x_prev.value()),
-            hi: (a1, st.x.value()),
-        };
-        sens.step_piece(self.vehicle, &lin, on.slot, piece);
+        let a0 = At { p: p0, ..run.a0 };
+        let ends = ((&a0, st.x_prev.value()), (&a1, st.x.value()));
+        sens.step_piece(
+            self.vehicle,
+            &lin,
+            on.slot,
+            piece_within(dx, dd, ends.0, ends.1),
+        );
         run.e2 = e2_next;
         run.a0 = a1;
         Ok(true)

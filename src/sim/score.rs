@@ -4,7 +4,7 @@
 use crate::model::{Cursor, Point};
 use crate::num::{Comp, Sum, min};
 
-use super::lin::{End, EndAt, PieceLin, Sensitivity};
+use super::lin::{End, EndAt, FastPiece, PieceLin, Sensitivity};
 use super::{Scenario, SimError};
 
 /// Score of one track over `[X_i, X_{i+1}]` (contract §8).
@@ -151,16 +151,15 @@ pub(super) fn trapezoid(len: f32, a2: f32, b2: f32) -> f32 {
 }
 
 /// A piece of a segment inside one track, between two scored samples at
-/// `x0` and `x1` (m).
+/// `x0` and `x1` (m): the fast path's, in parts (see [`FastPiece`]).
 #[inline(always)]
 pub(super) fn piece_within(
     dx: f32,
     dd: f32,
     (a0, x0): (&At, f32),
     (a1, x1): (&At, f32),
-) -> PieceLin {
-    PieceLin {
-        len: dx,
+) -> FastPiece {
+    FastPiece {
         dx,
         dd,
         lo: End {

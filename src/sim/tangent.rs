@@ -36,7 +36,7 @@
 use crate::model::Vehicle;
 
 use super::column::{Column, Factors, Gains};
-use super::lin::{FastPiece, PieceLin, Sensitivity, StepLin};
+use super::lin::{EndAt, FastPiece, PieceLin, Sensitivity, StepLin};
 use super::watch::Watch;
 use super::{Scenario, SimError, TrackScore, VehicleState};
 
@@ -105,7 +105,12 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
     /// before and after the step.
     #[inline(always)]
     fn step_piece(&mut self, v: &Vehicle<N>, lin: &StepLin, slot: usize, q: FastPiece) {
-        let ((lo, x_lo), (hi, x_hi)) = (q.lo, q.hi);
+        let (lo, hi) = (q.lo, q.hi);
+        let (EndAt::Start { slope: s0 }, EndAt::End { slope: s1 }) = (lo.at, hi.at) else {
+            self.step(v, lin);
+            self.piece(slot, &q.whole());
+            return;
+        };
         if lo.p > 0.0 || hi.p > 0.0 {
             self.step(v, lin);
             self.piece(slot, &q.whole());
@@ -115,9 +120,9 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
         let sq_e = 0.25 * (lo.e * lo.e + hi.e * hi.e);
         let half = 0.5 * q.dx;
         let (he_lo, he_hi) = (half * lo.e, half * hi.e);
-        let ends = ((lo.slope, hi.slope), (sq_e, he_lo, he_hi));
+        let ends = ((s0, s1), (sq_e, he_lo, he_hi));
         let n = lin.slot.saturating_add(1);
-        if self.watching && !self.watch.lower_recorded(x_lo) {
+        if self.watching && !self.watch.lower_recorded(lo.x) {
             let mut de = [(0.0, 0.0); K];
             for ((j, col), de) in self.cols.iter_mut().enumerate().zip(de.iter_mut()).take(n) {
                 *de = col.step_piece(&self.gains, &f, j == lin.slot, ends.0, ends.1);
@@ -128,7 +133,7 @@ impl<const N: usize, const K: usize> Sensitivity<N> for Tangents<'_, '_, N, K> {
         // Watched, the lower end is recorded already: the upper end's
         // `∂e` is written only when it sets its segment's minimum.
         let row = if self.watching {
-            self.watch.upper(slot, (x_hi, hi.e))
+            self.watch.upper(slot, (hi.x, hi.e))
         } else {
             None
         };
