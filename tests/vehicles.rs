@@ -280,6 +280,21 @@ fn a_freed_start_above_the_sqps_j_is_tried() {
     horizon_within("lift_freed_higher", 1.01, 3.403_426e6);
 }
 
+/// A later track freed to its deepest useful depth (`check_planner.py
+/// --seed 2203 --vehicle tools/reference/vehicles/integ.toml`,
+/// `unseen_2203_4`): the cold SQP ended with track 2 held at its target by
+/// track 1's depth; the lift toward track 2's preferred depth (its
+/// bottom's mean less `h_r`, 816 m) restarted into the same end. The best
+/// plan lifts track 1 by 67 m so that track 2 dives at the pitch limit the
+/// whole track (any depth below about 1 000 m flies the same). The line's
+/// `J` was 3.348e7 m³, 3.36× the f64 beam search's best safe plan
+/// (9.958 63e6 m³); now 1.0006×, from the start at track 2's deepest bottom
+/// less `h_r` (980 m).
+#[test]
+fn a_later_track_is_freed_to_its_deepest_depth() {
+    horizon_within("lift_floor", 1.01, 9.958_63e6);
+}
+
 /// A freed held edge ranked before an unfreed one (`check_planner.py
 /// --seed 2004`, `unseen_2004_6`, default vehicle). The cold call's last
 /// escape had two plateau edges: off track 2's, track 3 freed; off track

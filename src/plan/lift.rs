@@ -31,7 +31,16 @@
 //! best plan climbs 209 m on track 3 to fly track 4 250 m deeper). The
 //! least such lift found by doubling is narrowed by [`NARROW`] bisections
 //! (one flight each); where the climb saturates before any lift frees it,
-//! the least lift that reached the saturation is taken. Either start is
+//! the least lift that reached the saturation is taken. The same search
+//! is made for track `g` at its deepest useful depth (its deepest bottom
+//! less `h_r`) where that is more than the band below the preferred one:
+//! on a track whose bottom falls away, the best plan may dive at the pitch
+//! limit the whole track (a saturated plateau) from a start lifted further
+//! than the mean needs. On `check_planner.py --seed 2203 --vehicle
+//! tools/reference/vehicles/integ.toml` (`unseen_2203_4`) the preferred
+//! start (track 1 lifted 20 m, track 2 at 816 m) restarted into the SQP's
+//! end again; the deepest (track 1 lifted 90 m, track 2 at 980 m) ends at
+//! 1.0006× the f64 best safe plan, where the line was 3.36×. Either start is
 //! flown whole (one flight of the tail) and the SQP restarted from it,
 //! kept only if it ends better: a freed start (its infeasibility within
 //! the band) where the horizon's `J` is at most [`FREED_SHARE`] above the
@@ -47,7 +56,9 @@
 //! 1.062×, 6 flights a line more. With no bound, 50 move (`unseen_1205_4`
 //! 0.75×, its start 1.42× the SQP's) at 18 flights a line, and Monterey
 //! 2's cold call flies a start 1.33× the SQP's for nothing (+12 flights,
-//! +122 M instructions on the M4F).
+//! +122 M instructions on the M4F). The deepest depth's search moves 15 of
+//! the 256 lines (`unseen_1401_4` 0.79×, `unseen_1202_1` 0.93×,
+//! `unseen_1501_5` 1.003×) at 8.5 flights a line.
 
 use crate::optim::Bounds;
 use crate::sim::{Scenario, VehicleState};
@@ -149,7 +160,23 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             Next::Freed(start, deeper) => (Some(start), deeper, None),
             Next::Deep(lifts) => (None, None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Both(start, lifts) => (Some(start), None, Some(l.narrowed(obj, z, lifts)?)),
-            Next::Nothing => return Ok(None),
+            Next::Nothing => (None, None, None),
+        };
+        // Track `g` at its deepest useful depth (its deepest bottom less
+        // `h_r`), where that is more than the band below the preferred one
+        // (module docs): a fourth start, a deep one.
+        let floor = deepest(&obj.sc, obj.track.saturating_add(g), h_r)
+            .map(|p| p.min(hi))
+            .filter(|&p| p > l.deep.unwrap_or(zg) + band);
+        let lowest = match floor {
+            Some(p) => {
+                let l2 = Lift { deep: Some(p), ..l };
+                match l2.search(obj, z)? {
+                    Next::Deep(lifts) | Next::Both(_, lifts) => Some(l2.narrowed(obj, z, lifts)?),
+                    _ => None,
+                }
+            }
+            None => None,
         };
         // The start whose horizon `J` is lowest: a freed one (feasible
         // within the band) up to a share above the SQP's, a deep one below.
@@ -158,6 +185,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (freed, band, loose),
             (deeper, band, loose),
             (deep, f32::INFINITY, sqp),
+            (lowest, f32::INFINITY, sqp),
         ];
         let mut best: Option<([f32; K], f32)> = None;
         for (start, most, bar) in starts {
@@ -172,6 +200,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 }
 
 /// What is fixed while one later track's lift is sought.
+#[derive(Clone, Copy)]
 struct Lift<const N: usize> {
     /// The state track `j` starts in.
     at_j: VehicleState<N>,
@@ -311,6 +340,20 @@ impl<const N: usize> Lift<N> {
         }
         Ok(with_depth(&z, self.j, self.zj - free))
     }
+}
+
+/// The deepest useful depth of line track `t`: its deepest bottom sample
+/// less `h_r` (m); `None` without samples.
+fn deepest<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
+    let wp = sc.waypoints().positions();
+    let (&a, &b) = (wp.get(t)?, wp.get(t.saturating_add(1))?);
+    let p = sc.profile();
+    p.positions()
+        .iter()
+        .zip(p.depths())
+        .filter(|&(&x, _)| x >= a && x <= b)
+        .map(|(_, &d)| d - h_r)
+        .reduce(crate::num::max)
 }
 
 /// The preferred depth of line track `t`: the mean of its bottom samples
