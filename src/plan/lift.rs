@@ -31,9 +31,10 @@
 //! best plan climbs 209 m on track 3 to fly track 4 250 m deeper). The
 //! least such lift found by doubling is narrowed by [`NARROW`] bisections
 //! (one flight each); where the climb saturates before any lift frees it,
-//! the least lift that reached the saturation is taken. The same search
-//! is made for track `g` at its deepest useful depth (its deepest bottom
-//! less `h_r`) where that is more than the band below the preferred one:
+//! the least lift that reached the saturation is taken. Where no lift
+//! freed track `g`, the same search is made for track `g` at its deepest
+//! useful depth (its deepest bottom less `h_r`) where that is more than
+//! the band below the preferred one:
 //! on a track whose bottom falls away, the best plan may dive at the pitch
 //! limit the whole track (a saturated plateau) from a start lifted further
 //! than the mean needs. On `check_planner.py --seed 2203 --vehicle
@@ -162,12 +163,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             Next::Both(start, lifts) => (Some(start), None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Nothing => (None, None, None),
         };
-        // Track `g` at its deepest useful depth (its deepest bottom less
-        // `h_r`), where that is more than the band below the preferred one
-        // (module docs): a fourth start, a deep one.
+        // Where no lift frees track `g` by the band: track `g` at its
+        // deepest useful depth (its deepest bottom less `h_r`), where that
+        // is more than the band below the preferred one (module docs), a
+        // second deep start.
         let floor = deepest(&obj.sc, obj.track.saturating_add(g), h_r)
             .map(|p| p.min(hi))
-            .filter(|&p| p > l.deep.unwrap_or(zg) + band);
+            .filter(|&p| freed.is_none() && p > l.deep.unwrap_or(zg) + band);
         let lowest = match floor {
             Some(p) => {
                 let l2 = Lift { deep: Some(p), ..l };
