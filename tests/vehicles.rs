@@ -295,6 +295,21 @@ fn a_later_track_is_freed_to_its_deepest_depth() {
     horizon_within("lift_floor", 1.01, 9.958_63e6);
 }
 
+/// The deepest depth's start beside a freed one (`check_planner.py --seed
+/// 2004`, default vehicle, `unseen_2004_7`): the cold SQP ended with track
+/// 3 held at its target by track 2's depth (581 m), and the lift's freed
+/// start restarted into that end again. The best plan lifts track 2 by
+/// 60 m so that track 3 flies 29 m deeper and tracks 4 and 5 follow. The
+/// line's `J` was 2.95e6 m³, 1.31× the f64 beam search's best safe plan
+/// (2.253 95e6 m³); the restart from track 3's deepest depth (its deepest
+/// bottom less `h_r`, 636 m), after the freed start's, ends at 1.003×.
+/// (Ranked with the freed start by its `J` instead, it displaced it on
+/// `lift_freed_higher`: 0.991× → 1.318×; that test guards it.)
+#[test]
+fn the_deepest_depth_is_tried_after_a_freed_start() {
+    horizon_within("lift_both", 1.01, 2.253_95e6);
+}
+
 /// A freed held edge ranked before an unfreed one (`check_planner.py
 /// --seed 2004`, `unseen_2004_6`, default vehicle). The cold call's last
 /// escape had two plateau edges: off track 2's, track 3 freed; off track
