@@ -44,7 +44,7 @@
 //! is restarted after the best of the others (its `J` does not tell which
 //! ends better: ranked with them by `J`, it displaced the freed start of
 //! `unseen_2006_5` below, 0.991× → 1.318×), and kept only where it ends
-//! lower (`unseen_2004_7`: 1.31× → 1.003×). Either start is
+//! lower (`unseen_2004_7`: 1.31× → 1.003×). Each start is
 //! flown whole (one flight of the tail) and the SQP restarted from it,
 //! kept only if it ends better: a freed start (its infeasibility within
 //! the band) where the horizon's `J` is at most [`FREED_SHARE`] above the
