@@ -20,6 +20,7 @@
 mod column;
 mod error;
 mod estimate;
+mod fast;
 mod lin;
 #[cfg(test)]
 mod rng;
