@@ -362,33 +362,36 @@ impl<const N: usize> Lift<N> {
     }
 }
 
-/// The deepest useful depth of line track `t`: its deepest bottom sample
-/// less `h_r` (m); `None` without samples.
-fn deepest<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
+/// The bottom depths (m) of the profile's samples on line track `t`;
+/// `None` for a track the line does not have.
+fn track_bottom<'s, const N: usize>(
+    sc: &'s Scenario<'_, N>,
+    t: usize,
+) -> Option<impl Iterator<Item = f32> + 's> {
     let wp = sc.waypoints().positions();
     let (&a, &b) = (wp.get(t)?, wp.get(t.saturating_add(1))?);
     let p = sc.profile();
-    p.positions()
-        .iter()
-        .zip(p.depths())
-        .filter(|&(&x, _)| x >= a && x <= b)
-        .map(|(_, &d)| d - h_r)
+    Some(
+        p.positions()
+            .iter()
+            .zip(p.depths())
+            .filter(move |&(&x, _)| x >= a && x <= b)
+            .map(|(_, &d)| d),
+    )
+}
+
+/// The deepest useful depth of line track `t`: its deepest bottom sample
+/// less `h_r` (m); `None` without samples.
+fn deepest<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
+    track_bottom(sc, t)?
+        .map(|d| d - h_r)
         .reduce(crate::num::max)
 }
 
 /// The preferred depth of line track `t`: the mean of its bottom samples
 /// less the reference altitude `h_r` (m); `None` without samples.
 fn preferred<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
-    let wp = sc.waypoints().positions();
-    let (&a, &b) = (wp.get(t)?, wp.get(t.saturating_add(1))?);
-    let p = sc.profile();
-    let (sum, n) = p
-        .positions()
-        .iter()
-        .zip(p.depths())
-        .filter(|&(&x, _)| x >= a && x <= b)
-        .fold((0.0_f32, 0_u32), |(s, n), (_, &d)| {
-            (s + d, n.saturating_add(1))
-        });
+    let (sum, n) =
+        track_bottom(sc, t)?.fold((0.0_f32, 0_u32), |(s, n), d| (s + d, n.saturating_add(1)));
     (n > 0).then(|| sum / n as f32 - h_r)
 }
