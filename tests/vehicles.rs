@@ -349,3 +349,17 @@ fn a_restoring_plateau_scan_weighs_j_against_the_shortfall() {
 fn a_later_track_held_through_a_plateau_is_freed_on_a_second_order_vehicle() {
     horizon_within("freed_far_second", 1.01, 2.755_815e5);
 }
+
+/// A feasible cold SQP end with a track held far above its bottom
+/// (`check_planner.py --seed 2009 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_2009_2`). The two-path beam
+/// started at a plan 3.4× the best, and the SQP ended with track 3 flying
+/// 322 m above its bottom at its lowest (`h_r` 40 m), track 4 in a dive
+/// at the pitch limit and track 5 in a climb at it; the lift escape
+/// brought the line to 3.82e7 m³, 1.68× the f64 beam search's best safe
+/// plan (2.267 529e7 m³). The wide beam's start, now also taken where a
+/// track of a feasible end is held above twice `h_r`, ends at 0.74×.
+#[test]
+fn a_track_held_far_above_its_bottom_starts_a_wider_beam() {
+    horizon_within("held_high", 1.01, 2.267_529e7);
+}
