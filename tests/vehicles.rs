@@ -363,3 +363,14 @@ fn a_later_track_held_through_a_plateau_is_freed_on_a_second_order_vehicle() {
 fn a_track_held_far_above_its_bottom_starts_a_wider_beam() {
     horizon_within("held_high", 1.01, 2.267_529e7);
 }
+
+/// The same on the `rate` vehicle (`check_planner.py --seed 2005 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_2005_6`): the cold SQP
+/// ended feasible with tracks 2 and 3 at 124 and 125 m at their lowest
+/// (`h_r` 80 m), and the line's `J` was 6.495e6 m³, 1.26× the f64 beam
+/// search's best safe plan (5.140 149e6 m³). Held above 1.5 `h_r`, the
+/// wide beam's restart ends at 1.0009×.
+#[test]
+fn tracks_held_above_one_and_a_half_h_r_start_a_wider_beam() {
+    horizon_within("held_rate", 1.01, 5.140_149e6);
+}
