@@ -374,3 +374,15 @@ fn a_track_held_far_above_its_bottom_starts_a_wider_beam() {
 fn tracks_held_above_one_and_a_half_h_r_start_a_wider_beam() {
     horizon_within("held_rate", 1.01, 5.140_149e6);
 }
+
+/// The held edge's restart made again as a careful run (`check_planner.py
+/// --seed 2308 --vehicle tools/reference/vehicles/low.toml`,
+/// `unseen_2308_0`): from the start just off track 4's plateau the plain
+/// run's first step took track 3 243 m deeper into a flight 166 m short,
+/// and its end was not kept; the line's `J` was 3.785e7 m³, 1.63× the f64
+/// beam search's best safe plan (2.325 681e7 m³). The careful run (the
+/// rows its step would cross in the QP) ends at 1.0009×.
+#[test]
+fn a_held_edge_is_restarted_carefully_too() {
+    horizon_within("held_careful", 1.01, 2.325_681e7);
+}

@@ -247,8 +247,22 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// escapes start (`unseen_1404_5`: the lift found a lower `J` from
     /// where the plateau rounds left it, and none from the held edge's).
     /// On `unseen_1106_6` (`low`), track 3's depth on its plateau and
-    /// track 4 held by track 2's: 1.24× → 1.0005×. Returns the iterations
-    /// so far.
+    /// track 4 held by track 2's: 1.24× → 1.0005×.
+    ///
+    /// The restart is then made again from the same start as a careful
+    /// run (the rows beyond the band that its step would cross join the
+    /// QP), kept if it ends lower still. On `check_planner.py --seed 2308
+    /// --vehicle tools/reference/vehicles/low.toml` (`unseen_2308_0`) the
+    /// start just off track 4's plateau left track 4 46 m above its target
+    /// and track 3's rows flat in `z_3`: the plain run's first step took
+    /// `z_3` 243 m deeper (`∂J/∂z_3` = −2.2e5 m², nothing in the band
+    /// against it) into a flight 166 m short, and its end was not kept.
+    /// The careful run's first step is 70 m, and it ends with track 3 70 m
+    /// deeper and track 4 on its boundary: 1.63× → 1.0009× the f64 best
+    /// safe plan. (Careful alone, it also took `unseen_1105_7` (`stiff`)
+    /// from 1.0002× to 1.0052×; after the plain run, 3 of the 256 lines
+    /// move, all lower, for 3.8 evaluations a line.) Returns the
+    /// iterations so far.
     #[inline(never)]
     pub(super) fn held_last(
         &mut self,
@@ -273,7 +287,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let Some((_, z)) = best else {
             return iterations;
         };
-        self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
+        let iterations = self
+            .sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
+            .unwrap_or(iterations);
+        if iterations >= self.cfg.bfgs.max_iterations {
+            return iterations;
+        }
+        self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, true), iterations)
             .unwrap_or(iterations)
     }
 }
