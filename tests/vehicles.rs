@@ -386,3 +386,28 @@ fn tracks_held_above_one_and_a_half_h_r_start_a_wider_beam() {
 fn a_held_edge_is_restarted_carefully_too() {
     horizon_within("held_careful", 1.01, 2.325_681e7);
 }
+
+/// The deepest depth's search past a lift that frees the later track at
+/// its own depth (`check_planner.py --seed 2309 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_2309_6`): a 24 m lift of
+/// track 2 freed track 3 at its own depth and ended the search, so no
+/// start had track 3 at its deepest depth; the best plan lifts track 2 by
+/// 116 m for track 3 to dive 319 m deeper. The line's `J` was 1.631e7 m³,
+/// 1.53× the f64 beam search's best safe plan (1.066 789e7 m³); now
+/// 1.0014×.
+#[test]
+fn the_deepest_depth_is_sought_past_a_freeing_lift() {
+    horizon_within("lift_past_freed", 1.01, 1.066_789e7);
+}
+
+/// A deep start's next track raised out of the bottom (`check_planner.py
+/// --seed 2308 --vehicle tools/reference/vehicles/low.toml`,
+/// `unseen_2308_5`): the lift's start at track 2's preferred depth left
+/// track 3's saturated dive 165 m into the bottom, and the restart
+/// retreated track 2 (track 3's depth gave it no gradient). The line's
+/// `J` was 1.468e7 m³, 1.18× the f64 beam search's best safe plan
+/// (1.245 461e7 m³); with track 3 raised to clear its target, 0.994×.
+#[test]
+fn a_deep_start_raises_the_next_track_out_of_the_bottom() {
+    horizon_within("lift_repair", 1.01, 1.245_461e7);
+}

@@ -64,6 +64,23 @@
 //! the 256 lines (`unseen_1401_4` 0.79×, `unseen_1202_1` 0.93×,
 //! `unseen_1404_5` 0.94×; `unseen_1203_3` 1.021×, still 0.973× the f64
 //! best) at 14 flights a line.
+//!
+//! The deepest depth's search doubles the lift until track `g` at that
+//! depth clears its target; a lift that frees track `g` at its own depth
+//! first no longer ends it. On `check_planner.py --seed 2309 --vehicle
+//! tools/reference/vehicles/low.toml` (`unseen_2309_6`) a lift of 24 m
+//! freed track 3 at its own depth, so no deepest start was made; the best
+//! plan lifts track 2 by 116 m for track 3 to dive 319 m deeper: the line
+//! 1.53× the f64 best safe plan, now 1.0014×. And a start at the
+//! preferred or the deepest depth that leaves track `g + 1` more than the
+//! band below its target (a dive carried on from a deeper arrival) has
+//! depth `g + 1` raised to the deepest found that clears it (doubling,
+//! then [`NARROW`] bisections), since a later depth on a saturated
+//! plateau gives the restart's restoration no gradient: on `--seed 2308`
+//! (`low`, `unseen_2308_5`) the preferred start left track 3 165 m into
+//! the bottom, and the restart retreated track 2 instead; raised, the
+//! line goes from 1.18× to 0.994× the f64 best. (Raised wherever it is
+//! below its target at all, `lift_both` went back to 1.31×.)
 
 use crate::optim::Bounds;
 use crate::sim::{Scenario, VehicleState};
@@ -164,23 +181,17 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // (A freed start is kept within the band of feasible, as the SQP
         // left it; a start at the preferred depth may be far from it, the
         // climb saturated, and the restart's first steps close that.)
-        let (freed, deeper, deep) = match l.search(obj, z)? {
+        let (freed, deeper, deep) = match l.search(obj, z, true)? {
             Next::Freed(start, deeper) => (Some(start), deeper, None),
             Next::Deep(lifts) => (None, None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Both(start, lifts) => (Some(start), None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Nothing => (None, None, None),
         };
-        // Track `g` at its deepest useful depth (its deepest bottom less
-        // `h_r`), where that is more than the band below the preferred one
-        // (module docs): a start restarted from after the best one, since
-        // its `J` does not tell which ends better.
-        let floor = deepest(&obj.sc, obj.track.saturating_add(g), h_r)
-            .map(|p| p.min(hi))
-            .filter(|&p| p > l.deep.unwrap_or(zg) + band);
-        let lowest = match floor {
-            Some(p) => Lift { deep: Some(p), ..l }.deep_start(obj, z)?,
-            None => None,
-        };
+        // The deep starts with the track after `g` raised where they leave
+        // it more than the band below its target (module docs).
+        let next_lo = bounds.lo.get(g.saturating_add(1)).copied();
+        let deep = l.repaired(obj, deep, next_lo)?;
+        let lowest = l.floor_start(obj, z, (h_r, hi), next_lo)?;
         // The start whose horizon `J` is lowest: a freed one (feasible
         // within the band) up to a share above the SQP's, a deep one below.
         let (sqp, loose) = (self.work.j, (1.0 + FREED_SHARE) * self.work.j);
@@ -247,11 +258,14 @@ enum Next<const K: usize> {
 
 impl<const N: usize> Lift<N> {
     /// Depth `j` lifted by the band, doubling: one or two flights of the
-    /// two tracks per lift.
+    /// two tracks per lift. With `freed` false, only track `g` at its deep
+    /// depth is sought (a lift that frees track `g` at its own depth does
+    /// not end the search).
     fn search<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         mut z: [f32; K],
+        freed: bool,
     ) -> Result<Next<K>, Stop> {
         let (j, g) = (self.j, self.g);
         let mut lift = self.band;
@@ -262,7 +276,11 @@ impl<const N: usize> Lift<N> {
             let up = crate::num::max(self.zj - lift, self.lo);
             z = with_depth(&z, j, up);
             z = with_depth(&z, g, self.zg);
-            let freed = obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band;
+            let freed = if freed {
+                obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band
+            } else {
+                f32::NEG_INFINITY
+            };
             if freed >= 0.0 {
                 let start = with_depth(&z, g, self.zg + freed);
                 let Some(p) = self.deep.filter(|&p| p > self.zg + freed) else {
@@ -304,7 +322,7 @@ impl<const N: usize> Lift<N> {
         obj: &mut PlanObjective<'_, N>,
         z: [f32; K],
     ) -> Result<Option<[f32; K]>, Stop> {
-        Ok(match self.search(obj, z)? {
+        Ok(match self.search(obj, z, false)? {
             Next::Deep(lifts) | Next::Both(_, lifts) => Some(self.narrowed(obj, z, lifts)?),
             _ => None,
         })
@@ -343,6 +361,86 @@ impl<const N: usize> Lift<N> {
             }
         }
         Ok(clear)
+    }
+
+    /// Track `g` at its deepest useful depth (its deepest bottom less
+    /// `h_r`, m; not below `hi`, m), where that is more than the band
+    /// below the preferred one (module docs): a start restarted from after
+    /// the best one, since its `J` does not tell which ends better; with
+    /// track `g + 1` repaired ([`Lift::repaired`], `next_lo`).
+    fn floor_start<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        (h_r, hi): (f32, f32),
+        next_lo: Option<f32>,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let floor = deepest(&obj.sc, obj.track.saturating_add(self.g), h_r)
+            .map(|p| p.min(hi))
+            .filter(|&p| p > self.deep.unwrap_or(self.zg) + self.band);
+        let lowest = match floor {
+            Some(p) => Lift {
+                deep: Some(p),
+                ..*self
+            }
+            .deep_start(obj, z)?,
+            None => None,
+        };
+        self.repaired(obj, lowest, next_lo)
+    }
+
+    /// `start` (if any) with track `g + 1`'s depth raised, where the start
+    /// leaves that track more than the band below its target, to the
+    /// deepest depth found that clears it: shallower by the band, doubling
+    /// ([`LIFTS`] times at most, not above `lo`, m), then [`NARROW`]
+    /// bisections; one flight of tracks `j..=g + 1` each, and one to see
+    /// whether it is needed.
+    fn repaired<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        start: Option<[f32; K]>,
+        lo: Option<f32>,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let k = self.g.saturating_add(1);
+        let (Some(z), Some(lo)) = (start, lo) else {
+            return Ok(start);
+        };
+        let Some(&zk) = z.get(k).filter(|_| k < obj.count) else {
+            return Ok(start);
+        };
+        let target = obj.target_of(k);
+        let least = |obj: &mut PlanObjective<'_, N>, d: f32| {
+            obj.least_at((&self.at_j, self.j), &with_depth(&z, k, d), k)
+        };
+        if least(obj, zk)? >= target - self.band {
+            return Ok(start);
+        }
+        let clears = |obj: &mut PlanObjective<'_, N>, d: f32| least(obj, d).map(|a| a >= target);
+        let (mut held, mut step) = (zk, self.band);
+        let mut clear = None;
+        for _ in 0..LIFTS {
+            let up = crate::num::max(zk - step, lo);
+            if clears(obj, up)? {
+                clear = Some(up);
+                break;
+            }
+            if up <= lo {
+                break;
+            }
+            (held, step) = (up, 2.0 * step);
+        }
+        let Some(mut clear) = clear else {
+            return Ok(start);
+        };
+        for _ in 0..NARROW {
+            let mid = 0.5 * (clear + held);
+            if clears(obj, mid)? {
+                clear = mid;
+            } else {
+                held = mid;
+            }
+        }
+        Ok(Some(with_depth(&z, k, clear)))
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
