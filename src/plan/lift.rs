@@ -71,16 +71,21 @@
 //! tools/reference/vehicles/low.toml` (`unseen_2309_6`) a lift of 24 m
 //! freed track 3 at its own depth, so no deepest start was made; the best
 //! plan lifts track 2 by 116 m for track 3 to dive 319 m deeper: the line
-//! 1.53× the f64 best safe plan, now 1.0014×. And a start at the
-//! preferred or the deepest depth that leaves track `g + 1` more than the
-//! band below its target (a dive carried on from a deeper arrival) has
+//! 1.53× the f64 best safe plan, now 1.0014×. (Where the climb then
+//! saturates first, the start is kept only if track `g` is within the
+//! band of its target there: Monterey 1's deepest depths saturate 87 and
+//! 103 m into the bottom, and those starts cost its cold call 7 flights,
+//! 21.7 M instructions on the M4F, for nothing.) And the start at the
+//! deepest depth, where it leaves track `g + 1` more than the band below
+//! its target (a dive carried on from a deeper arrival), has
 //! depth `g + 1` raised to the deepest found that clears it (doubling,
 //! then [`NARROW`] bisections), since a later depth on a saturated
 //! plateau gives the restart's restoration no gradient: on `--seed 2308`
-//! (`low`, `unseen_2308_5`) the preferred start left track 3 165 m into
-//! the bottom, and the restart retreated track 2 instead; raised, the
-//! line goes from 1.18× to 0.994× the f64 best. (Raised wherever it is
-//! below its target at all, `lift_both` went back to 1.31×.)
+//! (`low`, `unseen_2308_5`) the start left track 3 165 m into the
+//! bottom, and the restart retreated track 2 instead; raised, the line
+//! goes from 1.18× to 0.994× the f64 best. (Raised wherever it is below
+//! its target at all, `lift_both` went back to 1.31×; the preferred
+//! depth's start raised too, `unseen_4242_5` went from 1.04× to 1.11×.)
 
 use crate::optim::Bounds;
 use crate::sim::{Scenario, VehicleState};
@@ -181,16 +186,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // (A freed start is kept within the band of feasible, as the SQP
         // left it; a start at the preferred depth may be far from it, the
         // climb saturated, and the restart's first steps close that.)
-        let (freed, deeper, deep) = match l.search(obj, z, true)? {
+        let (freed, deeper, deep) = match l.search(obj, z, false)? {
             Next::Freed(start, deeper) => (Some(start), deeper, None),
             Next::Deep(lifts) => (None, None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Both(start, lifts) => (Some(start), None, Some(l.narrowed(obj, z, lifts)?)),
             Next::Nothing => (None, None, None),
         };
-        // The deep starts with the track after `g` raised where they leave
-        // it more than the band below its target (module docs).
+        // The deepest depth's start with the track after `g` raised where
+        // it leaves it more than the band below its target (module docs).
         let next_lo = bounds.lo.get(g.saturating_add(1)).copied();
-        let deep = l.repaired(obj, deep, next_lo)?;
         let lowest = l.floor_start(obj, z, (h_r, hi), next_lo)?;
         // The start whose horizon `J` is lowest: a freed one (feasible
         // within the band) up to a share above the SQP's, a deep one below.
@@ -258,28 +262,30 @@ enum Next<const K: usize> {
 
 impl<const N: usize> Lift<N> {
     /// Depth `j` lifted by the band, doubling: one or two flights of the
-    /// two tracks per lift. With `freed` false, only track `g` at its deep
-    /// depth is sought (a lift that frees track `g` at its own depth does
-    /// not end the search).
+    /// two tracks per lift. With `past_freed`, a lift that frees track `g`
+    /// at its own depth but not at its deep one does not end the search:
+    /// the lifts go on for the deep depth alone (module docs).
     fn search<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         mut z: [f32; K],
-        freed: bool,
+        past_freed: bool,
     ) -> Result<Next<K>, Stop> {
         let (j, g) = (self.j, self.g);
         let mut lift = self.band;
         let mut held = 0.0;
         // Track `g`'s least altitude at its preferred depth, last lift, m.
         let mut last = f32::NEG_INFINITY;
+        // Whether a lift freed track `g` at its own depth already.
+        let mut passed = false;
         for _ in 0..LIFTS {
             let up = crate::num::max(self.zj - lift, self.lo);
             z = with_depth(&z, j, up);
             z = with_depth(&z, g, self.zg);
-            let freed = if freed {
-                obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band
-            } else {
+            let freed = if passed {
                 f32::NEG_INFINITY
+            } else {
+                obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band
             };
             if freed >= 0.0 {
                 let start = with_depth(&z, g, self.zg + freed);
@@ -290,8 +296,11 @@ impl<const N: usize> Lift<N> {
                 if obj.least_at((&self.at_j, j), &z, g)? >= self.target {
                     return Ok(Next::Both(start, (held, self.zj - up)));
                 }
-                let deeper = self.deepest(obj, z, (self.zg + freed, p))?;
-                return Ok(Next::Freed(start, Some(deeper)));
+                if !past_freed {
+                    let deeper = self.deepest(obj, z, (self.zg + freed, p))?;
+                    return Ok(Next::Freed(start, Some(deeper)));
+                }
+                passed = true;
             }
             if let Some(p) = self.deep {
                 z = with_depth(&z, g, p);
@@ -300,8 +309,15 @@ impl<const N: usize> Lift<N> {
                     return Ok(Next::Deep((held, self.zj - up)));
                 }
                 if a <= last + self.slack {
-                    // The climb saturates: no lift frees more.
-                    return Ok(Next::Deep((held, held)));
+                    // The climb saturates: no lift frees more. (Past a
+                    // freeing lift, kept only within the band of its
+                    // target: module docs.)
+                    let near = !passed || a >= self.target - self.band;
+                    return Ok(if near {
+                        Next::Deep((held, held))
+                    } else {
+                        Next::Nothing
+                    });
                 }
                 last = a;
             }
@@ -322,7 +338,7 @@ impl<const N: usize> Lift<N> {
         obj: &mut PlanObjective<'_, N>,
         z: [f32; K],
     ) -> Result<Option<[f32; K]>, Stop> {
-        Ok(match self.search(obj, z, false)? {
+        Ok(match self.search(obj, z, true)? {
             Next::Deep(lifts) | Next::Both(_, lifts) => Some(self.narrowed(obj, z, lifts)?),
             _ => None,
         })
