@@ -1,5 +1,5 @@
-//! A cold horizon whose SQP ended infeasible, started again from a wider
-//! beam.
+//! A cold horizon whose SQP ended infeasible, or feasible with a track
+//! held far above its bottom, started again from a wider beam.
 //!
 //! The beam scan (`scan.rs`) keeps two paths per track. A vehicle with
 //! little pitch authority (3 m/s and 15° on a random canyon line,
