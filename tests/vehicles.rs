@@ -411,16 +411,3 @@ fn the_deepest_depth_is_sought_past_a_freeing_lift() {
 fn a_deep_start_raises_the_next_track_out_of_the_bottom() {
     horizon_within("lift_repair", 1.01, 1.245_461e7);
 }
-
-/// The deepest depth's start restarted though its `J` is above the SQP's
-/// (`check_planner.py --seed 2309 --vehicle
-/// tools/reference/vehicles/low.toml`, `unseen_2309_1`): the start lifts
-/// track 1 by 108 m for track 2 at its deepest depth, its horizon `J`
-/// 1.29× the SQP's end, and was not restarted; the best plan lifts track
-/// 1 by 67 m and flies track 2 112 m deeper. The line's `J` was 7.886e6
-/// m³, 1.115× the f64 beam search's best safe plan (7.072 015e6 m³);
-/// restarted, 1.0014×.
-#[test]
-fn the_deepest_depth_is_restarted_above_the_sqps_j() {
-    horizon_within("lift_deepest_higher", 1.01, 7.072_015e6);
-}

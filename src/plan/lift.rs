@@ -86,13 +86,6 @@
 //! goes from 1.18× to 0.994× the f64 best. (Raised wherever it is below
 //! its target at all, `lift_both` went back to 1.31×; the preferred
 //! depth's start raised too, `unseen_4242_5` went from 1.04× to 1.11×.)
-//! The deepest depth's start is restarted where its horizon `J` is below
-//! [`DEEPEST_SHARE`] times the SQP's, not only below it: on `--seed 2309`
-//! (`low`, `unseen_2309_1`) it lifts track 1 by 108 m for track 2's
-//! deepest depth, 1.29× the SQP's `J`, and its restart ends at 1.0014× the
-//! f64 best, where the line was 1.115×. On the 256 lines 24 move, 22
-//! lower (to 0.9967×) and 2 higher (1.0009×), for 9.7 more evaluations a
-//! line; Monterey 2's cold call flies 12 more, Monterey 1's none.
 
 use crate::optim::Bounds;
 use crate::sim::{Scenario, VehicleState};
@@ -107,10 +100,6 @@ const LIFTS: u32 = 6;
 /// A freed start is tried where its horizon `J` is at most this share
 /// above the SQP's (module docs).
 const FREED_SHARE: f32 = 0.25;
-
-/// The deepest depth's start is restarted where its horizon `J` is below
-/// this many times the SQP's (module docs).
-const DEEPEST_SHARE: f32 = 1.5;
 
 /// Bisections of the least lift that frees a track's preferred depth.
 const NARROW: u32 = 3;
@@ -224,9 +213,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         }
         let lowest = match lowest {
-            Some(start) if obj.tail_value(&head, (&at_j, j), &start)?.0 < DEEPEST_SHARE * sqp => {
-                Some(start)
-            }
+            Some(start) if obj.tail_value(&head, (&at_j, j), &start)?.0 < sqp => Some(start),
             _ => None,
         };
         Ok([best.map(|(start, _)| start), lowest])
