@@ -287,13 +287,17 @@ impl<const N: usize> Lift<N> {
             } else {
                 obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band
             };
+            // Track `g`'s least altitude at its deep depth this lift, where
+            // the freeing branch flew it already.
+            let mut flown = None;
             if freed >= 0.0 {
                 let start = with_depth(&z, g, self.zg + freed);
                 let Some(p) = self.deep.filter(|&p| p > self.zg + freed) else {
                     return Ok(Next::Freed(start, None));
                 };
                 z = with_depth(&z, g, p);
-                if obj.least_at((&self.at_j, j), &z, g)? >= self.target {
+                let a = obj.least_at((&self.at_j, j), &z, g)?;
+                if a >= self.target {
                     return Ok(Next::Both(start, (held, self.zj - up)));
                 }
                 if !past_freed {
@@ -301,10 +305,14 @@ impl<const N: usize> Lift<N> {
                     return Ok(Next::Freed(start, Some(deeper)));
                 }
                 passed = true;
+                flown = Some(a);
             }
             if let Some(p) = self.deep {
                 z = with_depth(&z, g, p);
-                let a = obj.least_at((&self.at_j, j), &z, g)?;
+                let a = match flown {
+                    Some(a) => a,
+                    None => obj.least_at((&self.at_j, j), &z, g)?,
+                };
                 if a >= self.target {
                     return Ok(Next::Deep((held, self.zj - up)));
                 }
@@ -445,18 +453,17 @@ impl<const N: usize> Lift<N> {
             }
             (held, step) = (up, 2.0 * step);
         }
-        let Some(mut clear) = clear else {
+        let Some(clear) = clear else {
             return Ok(start);
         };
-        for _ in 0..NARROW {
-            let mid = 0.5 * (clear + held);
-            if clears(obj, mid)? {
-                clear = mid;
-            } else {
-                held = mid;
-            }
-        }
-        Ok(Some(with_depth(&z, k, clear)))
+        // (The same bisections as `clearing`, on track `g + 1`.)
+        let next = Lift {
+            g: k,
+            target,
+            ..*self
+        };
+        let d = next.clearing(obj, &z, (k, |d| d), (clear, held))?;
+        Ok(Some(with_depth(&z, k, d)))
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
