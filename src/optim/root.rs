@@ -248,6 +248,16 @@ mod tests {
     }
 
     /// A hinge: flat (margin 5) above 100 m, falling 1 m per m below.
+    /// A margin flat at `flat` (m) up to `corner`, then falling `fall` m
+    /// per unit of the argument.
+    fn flat_then_falling(
+        flat: f32,
+        fall: f32,
+        corner: f32,
+    ) -> impl Fn(f32) -> Result<(f32, ()), ()> + Copy {
+        move |t: f32| Ok((flat.min(flat - fall * (t - corner)), ()))
+    }
+
     fn hinge(z: f32) -> Result<(f32, f32), ()> {
         Ok((5.0_f32.min(105.0 - z), z))
     }
@@ -301,9 +311,7 @@ mod tests {
     /// search from its anchor, `search.rs`; before: stopped at the anchor).
     #[test]
     fn bisects_towards_a_flat_safe_sides_corner() {
-        let f = |t: f32| -> Result<(f32, ()), ()> {
-            Ok((0.0091_f32.min(0.0091 - 475.0 * (t - 0.89)), ()))
-        };
+        let f = flat_then_falling(0.0091, 475.0, 0.89);
         let r = safe_boundary((0.0, Some(0.0091)), (1.0, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!(r.z > 0.888 && g >= 0.0, "{} -> {g}", r.z);
@@ -317,9 +325,7 @@ mod tests {
     /// `unseen_81_4` track 2, `J` 4.7× the best safe.)
     #[test]
     fn a_secant_may_land_near_the_unsafe_end() {
-        let f = |z: f32| -> Result<(f32, ()), ()> {
-            Ok((0.089_f32.min(0.089 - 0.17 * (z - 1014.9)), ()))
-        };
+        let f = flat_then_falling(0.089, 0.17, 1014.9);
         let r = safe_boundary((810.38, Some(0.089)), (1016.59, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!(r.z > 1014.0 && g >= 0.0, "{} -> {g}", r.z);
@@ -331,9 +337,7 @@ mod tests {
     /// steps ran out at 841.04 m).
     #[test]
     fn leaves_a_flat_safe_side_above_the_tolerance() {
-        let f = |z: f32| -> Result<(f32, ()), ()> {
-            Ok((0.047_f32.min(0.047 - 1.6 * (z - 841.28)), ()))
-        };
+        let f = flat_then_falling(0.047, 1.6, 841.28);
         let r = safe_boundary((638.62, Some(0.047)), (889.84, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!(r.z > 841.2 && g >= 0.0, "{} -> {g}", r.z);
