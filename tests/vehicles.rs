@@ -411,3 +411,16 @@ fn the_deepest_depth_is_sought_past_a_freeing_lift() {
 fn a_deep_start_raises_the_next_track_out_of_the_bottom() {
     horizon_within("lift_repair", 1.01, 1.245_461e7);
 }
+
+/// The held track's wide restart after the lift, not before
+/// (`check_planner.py --seed 2002 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2002_0`): run before the
+/// lift, the restart took track 1 from 453 m to 152 m for 5 % of the
+/// cold horizon's `J` and was kept, where the lift from the SQP's end
+/// finds 42 % less. The line went from 1.0009× to 1.63× the f64 beam
+/// search's best safe plan (9.016 968e6 m³) in the seventeenth round;
+/// now 1.0009× again.
+#[test]
+fn a_held_track_restarts_after_the_lift() {
+    horizon_within("held_after_lift", 1.01, 9.016_968e6);
+}

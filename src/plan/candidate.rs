@@ -255,17 +255,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (skip, s.warm.is_none() && !declared),
         )?;
         if s.warm.is_none() {
-            let (h, mu) = (s.h, s.mu);
             let at = (tol, s.h_safe, iterations);
-            iterations = self.wider_start((&mut obj, fl, scan), (h, &s.bounds, mu), at);
-            // (Not under declared uncertainty: there every later track's
-            // target is `h_a + m_s`, most of them are at it, and the
-            // escape's restarts cost Monterey 1's certified cold call
-            // +27 %, the line over its 800 M instructions: BENCHMARKS.md.)
-            if !declared {
-                iterations = self.lift_earlier(&mut obj, (h, &s.bounds), tol, iterations);
-                iterations = self.held_last(&mut obj, (h, &s.bounds), tol, iterations);
-            }
+            let wide = (s.h, &s.bounds, s.mu);
+            iterations = self.cold_escapes((&mut obj, fl, scan), wide, at);
         }
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {
