@@ -412,6 +412,22 @@ fn a_deep_start_raises_the_next_track_out_of_the_bottom() {
     horizon_within("lift_repair", 1.01, 1.245_461e7);
 }
 
+/// The committed depth polished where the depth loop integrates
+/// (`check_planner.py --seed 2002 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP
+/// converged with track 1 at 533 m, 16 m above its least altitude's
+/// target, on a tooth whose slope (−8.2e3 m²) is a fifth of the trend's
+/// (−3.9e4 m², f64 differences over 3 m) and whose rows' gradients said a
+/// deeper track 1 pulled track 4 down. The line's `J` was 5.008e6 m³,
+/// 1.50× the f64 beam search's best safe plan (3.342 304e6 m³); with each
+/// call's first depth polished, 1.116× (track 1 at 564.6 m; the rest of
+/// the gap is tracks 3 and 4 moving together, which a one-depth polish
+/// does not do).
+#[test]
+fn the_committed_depth_is_polished_where_the_depth_loop_integrates() {
+    horizon_within("teeth_first", 1.12, 3.342_304e6);
+}
+
 /// The held track's wide restart after the lift, not before
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_0`): run before the

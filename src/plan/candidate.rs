@@ -259,6 +259,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let wide = (s.h, &s.bounds, s.mu);
             iterations = self.cold_escapes((&mut obj, fl, scan), wide, at);
         }
+        self.polish_first(&mut obj, (s.h, &s.bounds), tol);
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {
             iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), (tol, s.h_safe))?;

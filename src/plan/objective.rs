@@ -273,7 +273,7 @@ impl<const N: usize> PlanObjective<'_, N> {
 
     /// `(Σ J, v)` of the horizon's `scores` (m³, m): a non-finite `J` is
     /// a diverged flight.
-    fn value_of(&self, scores: &[TrackScore]) -> Result<(f32, f32), Stop> {
+    pub(super) fn value_of(&self, scores: &[TrackScore]) -> Result<(f32, f32), Stop> {
         let sc = scores.get(..self.count).unwrap_or(&[]);
         let total: f32 = sc.iter().map(TrackScore::j).sum();
         if total.is_finite() {

@@ -1,4 +1,5 @@
-//! A single track's optimum where `J` has small jumps.
+//! A single track's optimum, and a horizon's first depth, where `J` has
+//! small jumps.
 //!
 //! An autopilot whose depth loop integrates conditionally (contract §7,
 //! with `ki > 0`) makes `J(z)` a sawtooth: each time the sample at which
@@ -32,7 +33,20 @@
 //! ([`Planner::polish_boundary`]): on `check_planner.py --seed 1902
 //! --vehicle tools/reference/vehicles/integ.toml`, `unseen_1902_0`
 //! track 1 kept its boundary, 1.0087× the best safe `J`; now 1.0004×.
+//!
+//! A horizon's SQP meets the same teeth ([`Planner::polish_first`]): on
+//! `check_planner.py --seed 2002 --vehicle
+//! tools/reference/vehicles/integ.toml`, `unseen_2002_7`, the cold call
+//! converged with track 1 16 m above its target, its `∂J/∂z_1` a tooth's
+//! −8.2e3 m² where the trend is −3.9e4 m², and an active row of track 4
+//! whose gradient (a tooth's too) said a deeper track 1 pulled track 4
+//! down, while its least altitude stays within centimetres over 45 m of
+//! `z_1`. Each call's first depth is polished, the later depths held,
+//! where the depth loop integrates: the line went from 1.50× to 1.116×
+//! the best safe `J` (track 1 at 564.6 m; the best plan's 568.0 m).
 
+use crate::model::Uncertainty;
+use crate::num::min;
 use crate::optim::Bounds;
 
 use super::Planner;
@@ -81,7 +95,53 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !(libm::fabsf(g0) * STEP > share || fell > share) {
             return;
         }
-        self.polish_from(obj, (lo, hi), h_safe, (z0, j0));
+        self.polish_from(obj, (lo, hi), Clear::First(h_safe), (z0, j0));
+    }
+
+    /// The horizon's committed (first) depth polished as a single track's
+    /// (module docs), the later depths held, where the vehicle's depth
+    /// loop integrates (its `J` has teeth) and the SQP's end `self.work`
+    /// is feasible (infeasibility at most `tol`, m): every point kept has
+    /// each track's least altitude at most `tol` below the lower of its
+    /// target and its altitude at the end. Between teeth the exact
+    /// gradient is the tooth's slope, and an active row's gradient a
+    /// tooth's too, so the SQP can converge where the trend of `J` still
+    /// falls steeply into the safe set (and the later tracks' least
+    /// altitudes wander by millimetres with the teeth). One flight to
+    /// check the end, two or more for the polish. Not under declared
+    /// uncertainty.
+    #[inline(never)]
+    pub(super) fn polish_first(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+    ) {
+        let teeth = obj.sc.vehicle().autopilot().config().depth_pid.ki > 0.0;
+        let (Some(&z0), Some(&lo), Some(&hi)) =
+            (self.work.z.first(), bounds.lo.first(), bounds.hi.first())
+        else {
+            return;
+        };
+        // (Not under declared uncertainty: as the other escapes.)
+        let declared = *obj.sc.mission().uncertainty() != Uncertainty::NONE;
+        if h < 2 || !teeth || declared {
+            return;
+        }
+        let Ok(end) = obj.flight(&self.work.z) else {
+            return;
+        };
+        let Ok((j0, v0)) = obj.value_of(&end) else {
+            return;
+        };
+        if v0 > tol {
+            return;
+        }
+        let mut floors = [f32::NEG_INFINITY; K];
+        for (t, (floor, s)) in floors.iter_mut().zip(&end).enumerate().take(obj.count) {
+            *floor = min(s.min_altitude(), obj.target_of(t)) - tol;
+        }
+        self.polish_from(obj, (lo, hi), Clear::Floors(floors), (z0, j0));
     }
 
     /// The polish's search from a constrained track's boundary `(z, J)`
@@ -104,11 +164,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         obj.tripped = None;
         let guard = obj.guard;
-        self.polish_from(obj, (lo, hi), guard, (z, j))
+        self.polish_from(obj, (lo, hi), Clear::First(guard), (z, j))
     }
 
-    /// The polish's search from `(z0, J0)` (m, m³), the workspace's single
-    /// track at `z0`, in `[lo, hi]` (m): whatever the gradient says. Moves
+    /// The polish's search from `(z0, J0)` (m, m³), the workspace's first
+    /// track at `z0`, in `[lo, hi]` (m), its points clearing `clear`:
+    /// whatever the gradient says. Moves
     /// the workspace to the lowest point found below the stopping
     /// threshold; whether it moved. Out of line: one copy for both
     /// callers.
@@ -117,7 +178,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         &mut self,
         obj: &mut PlanObjective<'_, N>,
         (lo, hi): (f32, f32),
-        h_safe: Option<f32>,
+        clear: Clear<K>,
         (z0, j0): (f32, f32),
     ) -> bool {
         let bar = j0 - self.cfg.bfgs.tol.j_threshold(j0);
@@ -126,7 +187,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut at = |z: f32| {
             let z = inside(z);
             (z.to_bits() != z0.to_bits())
-                .then(|| flown_at(obj, (&base, z), h_safe))
+                .then(|| flown_at(obj, (&base, z), clear))
                 .flatten()
         };
         let sides = [at(z0 - STEP), at(z0 + STEP)];
@@ -173,20 +234,39 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 }
 
-/// `(z, J)` of the track flown at depth `z` (m) (the horizon `base`'s
-/// first), when its flight flies and its least altitude clears `h_safe`
-/// (m) if given. One plain flight; out of line, so that the polish holds
-/// one call of the simulation, not one per point.
+/// What a polished point must clear.
+#[derive(Clone, Copy)]
+pub(super) enum Clear<const K: usize> {
+    /// The first track's least altitude at or above this, if given (m).
+    First(Option<f32>),
+    /// Each track's least altitude at or above its floor (m).
+    Floors([f32; K]),
+}
+
+/// `(z, J)` of the horizon `base` flown with its first depth at `z` (m),
+/// when its flight flies and clears `clear`. One plain flight; out of
+/// line, so that the polish holds one call of the simulation, not one
+/// per point.
 #[inline(never)]
 fn flown_at<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     (base, z): (&[f32; K], f32),
-    h_safe: Option<f32>,
+    clear: Clear<K>,
 ) -> Option<(f32, f32)> {
     let mut zz = *base;
     *zz.first_mut()? = z;
-    let (j, least, _) = horizon_flight(obj, &zz).ok()?;
-    let safe = h_safe.is_none_or(|h| least >= h);
+    let (j, safe) = match clear {
+        Clear::First(h_safe) => {
+            let (j, least, _) = horizon_flight(obj, &zz).ok()?;
+            (j, h_safe.is_none_or(|h| least >= h))
+        }
+        Clear::Floors(floors) => {
+            let scores = obj.flight(&zz).ok()?;
+            let (j, _) = obj.value_of(&scores).ok()?;
+            let clear = scores.iter().zip(&floors).take(obj.count);
+            (j, clear.into_iter().all(|(s, f)| s.min_altitude() >= *f))
+        }
+    };
     (safe && j.is_finite()).then_some((z, j))
 }
 
