@@ -210,7 +210,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // Under declared uncertainty, unbudgeted: the targets raised by the
         // certification gaps (the last calls' first, `gaps.rs`).
         let certifying = self.cfg.constrained && self.budget.limit == u32::MAX;
-        let declared = *m.uncertainty() != crate::model::Uncertainty::NONE;
         let mut gaps = [0.0_f32; K];
         if certifying {
             for (dst, src) in gaps.iter_mut().zip(self.gaps.iter().skip(fl.track)) {
@@ -218,6 +217,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         }
         let mut obj = PlanObjective::new(penalized, fl.state, fl.track, s.h, 0.0);
+        let declared = obj.declared();
         obj.gaps = Cell::from_mut(&mut gaps[..]).as_slice_of_cells();
         obj.budget = self.budget.optimizer(fl.count)?;
         if self.cfg.constrained {

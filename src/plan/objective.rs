@@ -113,6 +113,12 @@ impl<const N: usize> PlanObjective<'_, N> {
         Ok(scores)
     }
 
+    /// Whether the mission declares uncertainty (the call certifies its
+    /// plan over the declared worlds).
+    pub(super) fn declared(&self) -> bool {
+        *self.sc.mission().uncertainty() != crate::model::Uncertainty::NONE
+    }
+
     /// The SQP's target altitude of track `t` of the horizon, m.
     pub(super) fn target_of(&self, t: usize) -> f32 {
         let base = if t == 0 { self.target.0 } else { self.target.1 };

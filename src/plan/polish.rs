@@ -45,7 +45,6 @@
 //! where the depth loop integrates: the line went from 1.50× to 1.116×
 //! the best safe `J` (track 1 at 564.6 m; the best plan's 568.0 m).
 
-use crate::model::Uncertainty;
 use crate::num::min;
 use crate::optim::Bounds;
 
@@ -124,8 +123,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return;
         };
         // (Not under declared uncertainty: as the other escapes.)
-        let declared = *obj.sc.mission().uncertainty() != Uncertainty::NONE;
-        if h < 2 || !teeth || declared {
+        if h < 2 || !teeth || obj.declared() {
             return;
         }
         let Ok(end) = obj.flight(&self.work.z) else {

@@ -41,7 +41,6 @@
 //! the lift and the held edge, which run again from it where it is kept
 //! ([`Planner::cold_escapes`]).
 
-use crate::model::Uncertainty;
 use crate::optim::Bounds;
 
 use super::Planner;
@@ -81,21 +80,28 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // target is `h_a + m_s`, most of them are at it, and the
         // escape's restarts cost Monterey 1's certified cold call
         // +27 %, the line over its 800 M instructions: BENCHMARKS.md.)
-        if *obj.sc.mission().uncertainty() != Uncertainty::NONE {
+        if obj.declared() {
             return iterations;
         }
-        for held in [false, true] {
-            if held {
-                let at = (tol, h_safe, iterations);
-                match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
-                    Some(it) => iterations = it,
-                    None => break,
-                }
-            }
-            iterations = self.lift_earlier(obj, (h, bounds), tol, iterations);
-            iterations = self.held_last(obj, (h, bounds), tol, iterations);
+        iterations = self.lift_then_held(obj, (h, bounds), tol, iterations);
+        let at = (tol, h_safe, iterations);
+        match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
+            Some(it) => self.lift_then_held(obj, (h, bounds), tol, it),
+            None => iterations,
         }
-        iterations
+    }
+
+    /// The lift (`lift.rs`), then the held edge (`jump.rs`, `held_last`),
+    /// after `iterations` so far; returns the iterations so far.
+    fn lift_then_held(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        iterations: u32,
+    ) -> u32 {
+        let iterations = self.lift_earlier(obj, (h, bounds), tol, iterations);
+        self.held_last(obj, (h, bounds), tol, iterations)
     }
 
     /// The second start of the module docs for a cold call's horizon of
@@ -148,11 +154,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// tracks) flies, at its lowest, more than [`HELD`] times `h_r` above
     /// the bottom (module docs).
     fn held_high(&self, obj: &mut PlanObjective<'_, N>, h: usize) -> bool {
-        let m = obj.sc.mission();
-        if *m.uncertainty() != Uncertainty::NONE {
+        if obj.declared() {
             return false;
         }
-        let high = HELD * m.reference_altitude();
+        let high = HELD * obj.sc.mission().reference_altitude();
         obj.flight(&self.work.z)
             .is_ok_and(|s| s.iter().take(h).any(|t| t.min_altitude() > high))
     }
