@@ -440,3 +440,16 @@ fn the_committed_depth_is_polished_where_the_depth_loop_integrates() {
 fn a_held_track_restarts_after_the_lift() {
     horizon_within("held_after_lift", 1.01, 9.016_968e6);
 }
+
+/// A later track counts as held further above its target where the depth
+/// loop integrates (`check_planner.py --seed 2003 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2003_1`): the SQP
+/// stopped on a tooth with track 2 0.27 m above its target (the lift's
+/// slack was a hundredth of the band, 0.2 m), held there by track 1, so
+/// no lift was tried; lifting track 1 by 2.9 m lets track 2 fly 23 m
+/// deeper. The line's `J` was 9.741e6 m³, 1.139× the f64 beam search's
+/// best safe plan (8.555 653e6 m³); now 1.046×.
+#[test]
+fn a_later_track_near_its_target_is_lifted_where_the_depth_loop_integrates() {
+    horizon_within("teeth_lift", 1.06, 8.555_653e6);
+}

@@ -113,6 +113,12 @@ impl<const N: usize> PlanObjective<'_, N> {
         Ok(scores)
     }
 
+    /// Whether the vehicle's depth loop integrates (`ki > 0`): it does so
+    /// conditionally, and `J` has teeth (`polish.rs`).
+    pub(super) fn teeth(&self) -> bool {
+        self.sc.vehicle().autopilot().config().depth_pid.ki > 0.0
+    }
+
     /// Whether the mission declares uncertainty (the call certifies its
     /// plan over the declared worlds).
     pub(super) fn declared(&self) -> bool {

@@ -116,14 +116,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         (h, bounds): (usize, &Bounds<K>),
         tol: f32,
     ) {
-        let teeth = obj.sc.vehicle().autopilot().config().depth_pid.ki > 0.0;
         let (Some(&z0), Some(&lo), Some(&hi)) =
             (self.work.z.first(), bounds.lo.first(), bounds.hi.first())
         else {
             return;
         };
         // (Not under declared uncertainty: as the other escapes.)
-        if h < 2 || !teeth || obj.declared() {
+        if h < 2 || !obj.teeth() || obj.declared() {
             return;
         }
         let Ok(end) = obj.flight(&self.work.z) else {
