@@ -170,11 +170,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<[Option<[f32; K]>; 2], Stop> {
         let h_r = obj.sc.mission().reference_altitude();
         let band = h_r - obj.sc.mission().min_altitude();
-        let slack = if obj.teeth() {
-            obj.held_slack(tol).max(TEETH_SLACK * band)
-        } else {
-            obj.held_slack(tol)
-        };
+        let teeth = if obj.teeth() { TEETH_SLACK * band } else { 0.0 };
+        let slack = obj.held_slack(tol).max(teeth);
         let j = g.saturating_sub(1);
         let z = self.work.z;
         let (head, at_j) = obj.head(&z, j)?;

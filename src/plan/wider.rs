@@ -152,11 +152,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// Whether a track of the SQP's end (one plain flight of its `h`
     /// tracks) flies, at its lowest, more than [`HELD`] times `h_r` above
-    /// the bottom (module docs).
+    /// the bottom (module docs). (Only asked without declared
+    /// uncertainty: `cold_escapes` returns before it.)
     fn held_high(&self, obj: &mut PlanObjective<'_, N>, h: usize) -> bool {
-        if obj.declared() {
-            return false;
-        }
         let high = HELD * obj.sc.mission().reference_altitude();
         obj.flight(&self.work.z)
             .is_ok_and(|s| s.iter().take(h).any(|t| t.min_altitude() > high))
