@@ -453,3 +453,22 @@ fn a_held_track_restarts_after_the_lift() {
 fn a_later_track_near_its_target_is_lifted_where_the_depth_loop_integrates() {
     horizon_within("teeth_lift", 1.06, 8.555_653e6);
 }
+
+/// A nearly flat unsafe side (`check_planner.py --seed 2401 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2401_3`, constrained
+/// track by track). Track 1's least altitude crosses 60 m at 906.6 m and
+/// levels off 0.86 m below it within 20 m; the boundary search's unit
+/// steps of the deficit crawled along that side (margins −0.8603,
+/// −0.8597, −0.8588 m) and ran out at the safe end, 898.1 m: `J`
+/// 2.39368e5 m³, 1.28× the f64 best safe 1.86746e5 m³ (906.495 m). Two
+/// unsafe margins whose secant misses the bracket now bisect.
+#[test]
+fn a_nearly_flat_unsafe_side_is_bisected() {
+    let t = &tracks_of("flat_unsafe_side", &["--mode", "track"], &[])[0];
+    let (j, h) = (
+        t["J"].as_f64().unwrap(),
+        t["min_altitude"].as_f64().unwrap(),
+    );
+    assert!(h >= 60.0, "track 1: least altitude {h}");
+    assert!(j <= 1.005 * 186_746.0, "track 1: J {j} vs the best safe");
+}
