@@ -454,6 +454,18 @@ fn a_later_track_near_its_target_is_lifted_where_the_depth_loop_integrates() {
     horizon_within("teeth_lift", 1.06, 8.555_653e6);
 }
 
+/// An infeasible end under the band starts a beam of eight paths
+/// (`check_planner.py --seed 2324 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2324_6`): the cold SQP
+/// ended 13.9 m short summed, tracks 2 and 3 held 210 m above their
+/// bottom by a saturated dive; the four-path beam's start ended 122 m
+/// short and was dropped. The line's `J` was 1.52172e8 m³, 3.08× the f64
+/// beam search's best safe plan (4.935 673e7 m³); now 1.003×.
+#[test]
+fn an_infeasible_end_starts_the_widest_beam() {
+    horizon_within("wide_infeasible", 1.01, 4.935_673e7);
+}
+
 /// A nearly flat unsafe side (`check_planner.py --seed 2401 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2401_3`, constrained
 /// track by track). Track 1's least altitude crosses 60 m at 906.6 m and

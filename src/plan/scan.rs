@@ -309,9 +309,13 @@ pub(super) fn scan_start<const N: usize, const K: usize>(
 /// Paths kept by the horizon's beam scan at each track.
 pub(super) const BEAM: usize = 2;
 
-/// Paths kept by the wider beam of a second start (`solve.rs`), and the
-/// most any beam keeps.
-pub(super) const BEAM_WIDE: usize = 4;
+/// Paths kept by the wider beam of a second start where the cold SQP
+/// ended infeasible (`wider.rs`), and the most any beam keeps.
+pub(super) const BEAM_WIDE: usize = 8;
+
+/// Paths kept by the wider beam of a second start where the cold SQP
+/// ended feasible with a held track (`wider.rs`).
+pub(super) const BEAM_HELD: usize = 4;
 
 /// One path of the beam scan: its depths so far, the objective they add
 /// up to and the state they leave.
