@@ -466,6 +466,22 @@ fn an_infeasible_end_starts_the_widest_beam() {
     horizon_within("wide_infeasible", 1.01, 4.935_673e7);
 }
 
+/// A narrow basin beside a plateau (`check_planner.py --seed 2402
+/// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2402_1`, track 4,
+/// unconstrained): the scan's best depth, 1 256.6 m, sat in a basin 30 m
+/// wide, 0.7 % below a plateau; its parabola's vertex, 1 227.06 m, on the
+/// plateau, where `J`'s gradient (−0.11 m²) stopped BFGS at once: `J`
+/// 1.26464e5 m³, 1.0074× the f64 best 1.25534e5 m³ (1 256.93 m). The
+/// optimizer now restarts from the best scanned depth where it ended above
+/// it.
+#[test]
+fn a_run_ended_above_the_best_scanned_depth_restarts_there() {
+    let premise = [(0, 1170.907), (1, 1168.060), (2, 1375.891)];
+    let t = &tracks_of("scan_basin", &UNCONSTRAINED, &premise)[3];
+    let j = t["J"].as_f64().unwrap();
+    assert!(j <= 1.005 * 1.255_34e5, "track 4: J {j} vs the best");
+}
+
 /// A nearly flat unsafe side (`check_planner.py --seed 2401 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2401_3`, constrained
 /// track by track). Track 1's least altitude crosses 60 m at 906.6 m and

@@ -144,6 +144,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let iterations = self.penalty_stages(&mut obj, (s.h, &s.bounds), first_step)?;
         let iterations =
             self.escape_plateaus(&mut obj, (s.h, &s.bounds), first_step, iterations)?;
+        let iterations =
+            self.restart_from_scanned(&mut obj, (s.h, &s.bounds), (&scan, first_step), iterations)?;
         if s.h == 1 && self.cfg.method == Method::Bfgs && (single || !self.cfg.constrained) {
             let guard = obj.guard;
             self.polish_single(&mut obj, &s.bounds, guard);
