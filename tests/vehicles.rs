@@ -500,3 +500,15 @@ fn a_nearly_flat_unsafe_side_is_bisected() {
     assert!(h >= 60.0, "track 1: least altitude {h}");
     assert!(j <= 1.005 * 186_746.0, "track 1: J {j} vs the best safe");
 }
+
+/// A corner of a later track's boundary (`check_planner.py --seed 2403
+/// --vehicle tools/reference/vehicles/low.toml`, `unseen_2403_5`): the
+/// cold SQP converged with track 1 free, 12 m above its target, and track
+/// 2 on its boundary where another of its samples takes over setting its
+/// least altitude as track 1 dives (`src/plan/stride.rs`). The line's `J`
+/// was 3.64756e6 m³, 1.35× the f64 beam search's best safe plan
+/// (2.692 391e6 m³); the restart from `z_1` a band deeper: 1.002×.
+#[test]
+fn a_free_first_track_strides_past_a_corner() {
+    horizon_within("stride_corner", 1.01, 2.692_391e6);
+}

@@ -156,6 +156,7 @@ mod search;
 mod single;
 mod solve;
 mod status;
+mod stride;
 mod wider;
 mod within;
 

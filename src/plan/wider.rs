@@ -71,7 +71,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// declared uncertainty, the lift (`lift.rs`) and the held edge
     /// (`jump.rs`, `held_last`); then the wide beam where a track of that
     /// end is held far above its bottom, and where that restart is kept,
-    /// the lift and the held edge again from it. (The held track's restart
+    /// the lift and the held edge again from it; last, the first depth's
+    /// stride (`stride.rs`). (The held track's restart
     /// first ran before the lift, kept where it beat the SQP's end: on
     /// `check_planner.py --seed 2002 --vehicle
     /// tools/reference/vehicles/integ.toml`, `unseen_2002_0`, it took
@@ -98,10 +99,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         iterations = self.lift_then_held(obj, (h, bounds), tol, iterations);
         let at = (tol, h_safe, iterations);
-        match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
+        let iterations = match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
             Some(it) => self.lift_then_held(obj, (h, bounds), tol, it),
             None => iterations,
-        }
+        };
+        self.stride_first(obj, (h, bounds), tol, iterations)
     }
 
     /// The lift (`lift.rs`), then the held edge (`jump.rs`, `held_last`),
