@@ -482,6 +482,18 @@ fn a_run_ended_above_the_best_scanned_depth_restarts_there() {
     assert!(j <= 1.005 * 1.255_34e5, "track 4: J {j} vs the best");
 }
 
+/// An end infeasible by less than the band starts the wide beam too
+/// (`check_planner.py --seed 2409 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2409_6`): the cold SQP
+/// stopped after one iteration 16.9 m short summed (the band is 20 m),
+/// its depths on a saturated dive's plateau, and only an end short by
+/// more than the band restarted. The line's `J` was 2.23998e7 m³, 1.52×
+/// the f64 beam search's best safe plan (1.470 67e7 m³); now 1.0006×.
+#[test]
+fn an_end_short_by_less_than_the_band_starts_the_wide_beam() {
+    horizon_within("wide_short", 1.01, 1.470_67e7);
+}
+
 /// A nearly flat unsafe side (`check_planner.py --seed 2401 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2401_3`, constrained
 /// track by track). Track 1's least altitude crosses 60 m at 906.6 m and

@@ -8,13 +8,22 @@
 //! start infeasible by 279 m summed the SQP restored feasibility with the
 //! one depth that moves anything, the first (394 → 133 m; 399.5 m in the
 //! f64 best), and the line's `J` was 2.04× the best safe. Where the SQP
-//! ends infeasible by more than `h_r − h_a` summed, the scan runs again
-//! with a wider beam and the SQP restarts from its best path, kept
-//! if it ends better (feasible, or less infeasible). A feasible end costs
-//! nothing, nor does the usual infeasible end, a plan that misses its
-//! certification gaps or the later tracks' margin by less (Monterey 2
-//! certified), or a call whose first track has no safe scanned depth
-//! (Monterey 3).
+//! ends infeasible, the scan runs again with a wider beam and the SQP
+//! restarts from its best path, kept if it ends better (feasible, or less
+//! infeasible). A feasible end costs nothing, nor does a call whose first
+//! track has no safe scanned depth (Monterey 3). Under declared
+//! uncertainty only an end infeasible by more than `h_r − h_a` summed
+//! restarts: the usual end there misses its certification gaps or the
+//! later tracks' margin by less (Monterey 2 certified). Without it, any
+//! infeasible end does (it restarted only past the band before): on
+//! `check_planner.py --seed 2409 --vehicle
+//! tools/reference/vehicles/integ.toml` (`unseen_2409_6`) the cold SQP
+//! stopped after one iteration 16.9 m short summed, its depths on a
+//! saturated dive's plateau, and the line's `J` was 1.52× the f64
+//! search's best safe plan; restarted from the wide beam, 1.0006×. On the
+//! 256 random lines of the earlier rounds no plan moves, at 6.1 more
+//! evaluations a line (lines with no safe plan restart in vain); the 24
+//! shared runs give the same JSON.
 //!
 //! A feasible end can be as far from the best: on `check_planner.py --seed
 //! 2009 --vehicle tools/reference/vehicles/low.toml` (`unseen_2009_2`)
@@ -41,18 +50,16 @@
 //! the lift and the held edge, which run again from it where it is kept
 //! ([`Planner::cold_escapes`]).
 //!
-//! Where the end is infeasible (by any amount over the tolerance) the
-//! beam keeps [`BEAM_WIDE`] paths, else [`BEAM_HELD`]. On
+//! Where the end is infeasible the beam keeps [`BEAM_WIDE`] paths, where
+//! it has a held track [`BEAM_HELD`]. On
 //! `check_planner.py --seed 2324 --vehicle
 //! tools/reference/vehicles/integ.toml` (`unseen_2324_6`) the cold SQP
 //! ended 13.9 m short summed, under the band, with tracks 2 and 3 held
-//! 210 m above their bottom by a saturated dive: the four-path beam's
-//! start ended 122 m short and was dropped, and the line's `J` was 3.08×
-//! the f64 search's best safe plan (track 1 at 744 m, where the best
-//! plan dives to 983 m). Eight paths start feasible (5.045e7 m³), and
-//! the line ends at 1.003×. On the 256 random lines of the earlier
-//! rounds no plan moves, at 2.7 more evaluations a line; the 24 shared
-//! runs give the same JSON.
+//! 210 m above their bottom by a saturated dive: the held track's
+//! four-path beam (the only restart then) started 122 m short and was
+//! dropped, and the line's `J` was 3.08× the f64 search's best safe plan
+//! (track 1 at 744 m, where the best plan dives to 983 m). Eight paths
+//! start feasible (5.045e7 m³), and the line ends at 1.003×.
 
 use crate::optim::Bounds;
 
@@ -142,10 +149,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !first_safe || iterations >= self.cfg.bfgs.max_iterations {
             return None;
         }
-        let start = if held {
-            obj.last_violation <= band && self.held_high(obj, h)
+        // (An infeasible end is the first restart's, a feasible one the
+        // held track's: never the same beam twice.)
+        let (start, width) = if held {
+            let v = obj.last_violation;
+            (v <= tol && self.held_high(obj, h), BEAM_HELD)
         } else {
-            obj.last_violation > band
+            let over = if obj.declared() { band } else { tol };
+            (obj.last_violation > over, BEAM_WIDE)
         };
         if !start {
             return None;
@@ -157,11 +168,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             points: self.cfg.scan_points,
             mu,
             beam: true,
-            width: if obj.last_violation > tol {
-                BEAM_WIDE
-            } else {
-                BEAM_HELD
-            },
+            width,
         };
         let z = wide_scan(fl, &spec)?;
         self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
