@@ -54,6 +54,20 @@ fn a_crawl_down_a_sawtooth_is_cut_short() {
     assert!(j <= 1.005 * 4.652_41e4, "track 1: J {j} vs the best");
 }
 
+/// A quiet tooth (`check_planner.py --seed 2418 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_2418_4`, track 3): BFGS
+/// stopped at 420.68 m, `J` 2.2957e6 m³, 9 m short of the basin, on a
+/// tooth whose slope and last decrease were too small to call the polish.
+/// The polish now runs wherever the depth loop integrates. The f64 best
+/// from track 2's end (533.253 m): 2.20399e6 m³ (428.85 m).
+#[test]
+fn a_quiet_tooth_is_polished_where_the_depth_loop_integrates() {
+    let premise = [(0, 369.093), (1, 533.253)];
+    let t = &tracks_of("tooth_quiet", &UNCONSTRAINED, &premise)[2];
+    let j = t["J"].as_f64().unwrap();
+    assert!(j <= 1.005 * 2.203_99e6, "track 3: J {j} vs the best");
+}
+
 /// A concave stretch (`check_planner.py --seed 1404 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_1404_5`, track 2): `J`
 /// fell at least linearly along each step, the curvature guard skipped
