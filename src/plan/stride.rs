@@ -61,8 +61,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// cold call's horizon of `h` tracks in `bounds`, feasible within
     /// `tol` (m), after `iterations` so far; returns the iterations so far
     /// (a kept restart's). One plain flight to check the first track,
-    /// then at most [`STRIDES`] SQP restarts. Not inlined: its state stays
-    /// off the SQP runs' stack.
+    /// then at most [`STRIDES`] SQP restarts: the first that ends lower
+    /// ends the search, kept only if it gains more than [`GAIN`] (a
+    /// nearer basin found by the band's stride is not looked past). Not
+    /// inlined: its state stays off the SQP runs' stack.
     #[inline(never)]
     pub(super) fn stride_first(
         &mut self,
