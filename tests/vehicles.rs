@@ -68,6 +68,20 @@ fn a_quiet_tooth_is_polished_where_the_depth_loop_integrates() {
     assert!(j <= 1.005 * 2.203_99e6, "track 3: J {j} vs the best");
 }
 
+/// A bump of the teeth (`check_planner.py --seed 2402 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_2402_0`, track 4): BFGS
+/// ended at 943.12 m, `J` 10 394.5 m³, with `J` higher half a metre to
+/// either side, 1.75 m short of the basin: 1.040× the f64 best 9 993.61
+/// m³ (944.871 m, from the tool's track 3). The polish's wider look (2 m)
+/// finds it.
+#[test]
+fn a_bump_of_the_teeth_is_looked_past() {
+    let premise = [(0, 808.251), (1, 823.838), (2, 922.573)];
+    let t = &tracks_of("tooth_bump", &UNCONSTRAINED, &premise)[3];
+    let j = t["J"].as_f64().unwrap();
+    assert!(j <= 1.005 * 9_993.61, "track 4: J {j} vs the best");
+}
+
 /// A concave stretch (`check_planner.py --seed 1404 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_1404_5`, track 2): `J`
 /// fell at least linearly along each step, the curvature guard skipped
