@@ -242,6 +242,18 @@ impl Tolerances {
     }
 }
 
+/// An outcome's first coordinate in a box ([`Outcome::first_in`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct First {
+    /// The coordinate (unit of the variable: m for a depth).
+    pub z: f32,
+    /// The gradient's entry there (objective unit per variable unit).
+    pub g: f32,
+    /// The box's bounds on it (unit of the variable).
+    pub lo: f32,
+    pub hi: f32,
+}
+
 /// How many objective values an [`Outcome`] keeps (the first ones).
 pub const HISTORY: usize = 256;
 
@@ -307,6 +319,18 @@ impl<const K: usize> Outcome<K> {
         (self.grad_norm, self.status) = (mark.grad_norm, mark.status);
         (self.iterations, self.evaluations, self.skipped_updates) = mark.counts;
         self.history.truncate(mark.history);
+    }
+
+    /// The first coordinate in `bounds` (a single track's depth, or a
+    /// horizon's committed one): its value, the gradient's entry and the
+    /// box's bounds on it, if `K > 0`.
+    pub(crate) fn first_in(&self, bounds: &Bounds<K>) -> Option<First> {
+        Some(First {
+            z: *self.z.first()?,
+            g: *self.gradient.first()?,
+            lo: *bounds.lo.first()?,
+            hi: *bounds.hi.first()?,
+        })
     }
 
     /// This outcome made [`Outcome::at`] `z` in place (no temporary of

@@ -14,7 +14,7 @@
 //! coordinates instead, `solve.rs`.)
 
 use crate::num::{max, min};
-use crate::optim::Bounds;
+use crate::optim::{Bounds, First};
 
 use super::fallback::boundary;
 use super::flights::Flights;
@@ -56,12 +56,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         mut iterations: u32,
     ) -> Result<u32, PlanError> {
         let w = &self.work;
-        let (Some(&z), Some(&g), Some(&lo), Some(&hi)) = (
-            w.z.first(),
-            w.gradient.first(),
-            bounds.lo.first(),
-            bounds.hi.first(),
-        ) else {
+        let Some(First { z, g, lo, hi }) = w.first_in(bounds) else {
             return Ok(iterations);
         };
         if g != 0.0 || lo >= hi {

@@ -64,7 +64,7 @@
 //! the best safe `J` (track 1 at 564.6 m; the best plan's 568.0 m).
 
 use crate::num::min;
-use crate::optim::Bounds;
+use crate::optim::{Bounds, First};
 
 use super::Planner;
 use super::objective::PlanObjective;
@@ -97,12 +97,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         h_safe: Option<f32>,
     ) {
         let w = &self.work;
-        let (Some(&z0), Some(&g0), Some(&lo), Some(&hi)) = (
-            w.z.first(),
-            w.gradient.first(),
-            bounds.lo.first(),
-            bounds.hi.first(),
-        ) else {
+        let Some(First {
+            z: z0,
+            g: g0,
+            lo,
+            hi,
+        }) = w.first_in(bounds)
+        else {
             return;
         };
         let j0 = w.j;
@@ -137,9 +138,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         (h, bounds): (usize, &Bounds<K>),
         tol: f32,
     ) {
-        let (Some(&z0), Some(&lo), Some(&hi)) =
-            (self.work.z.first(), bounds.lo.first(), bounds.hi.first())
-        else {
+        let Some(First { z: z0, lo, hi, .. }) = self.work.first_in(bounds) else {
             return;
         };
         // (Not under declared uncertainty: as the other escapes.)

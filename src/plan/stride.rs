@@ -36,7 +36,7 @@
 //! [`GAIN`]; a nearer one is left to the later calls.
 
 use crate::num::{max, min};
-use crate::optim::Bounds;
+use crate::optim::{Bounds, First};
 
 use super::Planner;
 use super::objective::PlanObjective;
@@ -76,12 +76,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let m = obj.sc.mission();
         let band = m.reference_altitude() - m.min_altitude();
         let w = &self.work;
-        let (Some(&z1), Some(&g1), Some(&lo), Some(&hi)) = (
-            w.z.first(),
-            w.gradient.first(),
-            bounds.lo.first(),
-            bounds.hi.first(),
-        ) else {
+        let Some(First {
+            z: z1,
+            g: g1,
+            lo,
+            hi,
+        }) = w.first_in(bounds)
+        else {
             return iterations;
         };
         let promise = libm::fabsf(g1) * band > PROMISE * libm::fabsf(w.j);
