@@ -78,6 +78,27 @@ pub fn horizon_within(name: &str, ratio: f64, best: f64) {
     assert!(total <= ratio * best, "J {total} vs the best safe {best}");
 }
 
+/// Track `i` (from 0) of `plan ARGS... --json` on fixture `name`, after
+/// the premise (as [`tracks_of`]), its `J` within 0.5 % of `best` (m³):
+/// the f64 search's best from the same start, the checker's bound for a
+/// track.
+pub fn track_within(
+    name: &str,
+    args: &[&str],
+    premise: &[(usize, f64)],
+    i: usize,
+    best: f64,
+) -> serde_json::Value {
+    let t = tracks_of(name, args, premise)[i].clone();
+    let j = t["J"].as_f64().unwrap();
+    assert!(
+        j <= 1.005 * best,
+        "track {}: J {j} vs the best {best}",
+        i + 1
+    );
+    t
+}
+
 /// The tracks of `plan ARGS... --json` on fixture `name`, after checking
 /// the premise: track `i`'s depth within 1 cm of `depth` (m) for each
 /// `(i, depth)` of `premise`.
