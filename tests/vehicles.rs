@@ -536,3 +536,29 @@ fn a_nearly_flat_unsafe_side_is_bisected() {
 fn a_free_first_track_strides_past_a_corner() {
     horizon_within("stride_corner", 1.01, 2.692_391e6);
 }
+
+/// A floor set by the arrival (`check_planner.py --seed 2530 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_2530_2`, constrained track
+/// by track). Track 3 begins where track 2's dive leaves the vehicle
+/// 28.0016 m above its bottom whatever track 3's depth (down to about
+/// 1 131.5 m), 0.4 mm inside the planner's margin over `h_a` = 28 m, so no
+/// depth is safe to the planner. It answered the first safest scanned
+/// depth, 987.4 m: `J` 4.86241e6 m³, 6.7× the f64 best safe 7.2241e5 m³
+/// (1 131.535 m), and said `infeasible` where a depth is safe in the
+/// model. On a floor that clears `h_a` the least `J` is now answered, safe
+/// and constrained (`src/plan/single.rs`, `safest`).
+#[test]
+fn a_floor_set_by_the_arrival_answers_its_least_j() {
+    let premise = [(0, 814.081), (1, 1166.436)];
+    let t = track_within(
+        "arrival_floor",
+        &["--mode", "track"],
+        &premise,
+        2,
+        722_410.0,
+    );
+    let h = t["min_altitude"].as_f64().unwrap();
+    assert!(h >= 28.0, "track 3: least altitude {h}");
+    assert_eq!(t["status"], "constrained", "on the floor: {t}");
+    assert_eq!(t["safe"], true, "on the floor: {t}");
+}

@@ -77,8 +77,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         track: usize,
     ) -> Result<Candidate<N>, PlanError> {
         let mut c = self.candidate_aimed(sc, state, track)?;
-        // (What the commit certifies against: the certified altitude.)
-        c.h_safe = sc.mission().min_altitude() + self.cfg.safety_margin;
+        // (What the commit certifies against: the certified altitude, or
+        // a single track's floor set by its arrival, `single.rs`.)
+        c.h_safe = c
+            .h_safe
+            .min(sc.mission().min_altitude() + self.cfg.safety_margin);
         self.off_the_edge(sc, state, track, &mut c);
         Ok(c)
     }
@@ -281,27 +284,26 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         (z0, curvature): (&mut [f32; K], &mut [f32; K]),
     ) -> Result<Option<Candidate<N>>, PlanError> {
         let vertex = z0.first().copied().unwrap_or(0.0);
-        match single::decide(fl, scan, vertex, s.h_safe, self.cfg.bisection_steps)? {
-            Decision::Done(f, found) => {
-                self.work.history.clear();
-                let _ = self.work.history.push(f.score.j());
-                Ok(Some(self.single_candidate(
-                    f,
-                    found,
-                    (0, fl.count),
-                    s.h_safe,
-                )))
-            }
-            Decision::Optimize { z0: z, flat } => {
-                if let Some(slot) = z0.first_mut() {
-                    *slot = z;
+        let h_a = fl.sc.mission().min_altitude();
+        let h = (h_a, s.h_safe);
+        let (f, found, h_safe) =
+            match single::decide(fl, scan, vertex, h, self.cfg.bisection_steps)? {
+                Decision::Done(f, found) => (f, found, s.h_safe),
+                Decision::Floor(f, floor) => (f, Found::Boundary(OptimizerStop::None), floor),
+                Decision::Optimize { z0: z, flat } => {
+                    if let Some(slot) = z0.first_mut() {
+                        *slot = z;
+                    }
+                    if flat {
+                        *curvature = [0.0; K];
+                    }
+                    return Ok(None);
                 }
-                if flat {
-                    *curvature = [0.0; K];
-                }
-                Ok(None)
-            }
-        }
+            };
+        self.work.history.clear();
+        let _ = self.work.history.push(f.score.j());
+        let at = (0, fl.count);
+        Ok(Some(self.single_candidate(f, found, at, h_safe)))
     }
 
     /// The candidate when a constrained single track's optimizer left the

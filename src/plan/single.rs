@@ -6,7 +6,10 @@
 //! [`super::fallback::boundary`] finds it in a few plain flights, and a
 //! finite difference of `J` there confirms that `J` does not decrease into
 //! the safe set (if it does, the optimizer runs from there). With no
-//! scanned depth safe, the track is infeasible.
+//! scanned depth safe, the track is infeasible, unless its least altitude
+//! is a floor set by the arrival that clears `h_a` inside the planner's
+//! margin: then the floor's least `J` is answered, certified against the
+//! floor ([`safest`]).
 
 use crate::optim::Outcome;
 
@@ -24,6 +27,10 @@ pub(super) const CHECK_STEP: f32 = 2.0;
 /// an interior optimum within the first step leaves `J` higher at its end.
 pub(super) const CHECK_SHORT: f32 = 0.25;
 
+/// How far below the safest scanned altitude (m) a depth still shares
+/// it: the floor of [`safest`].
+const FLOOR: f32 = 1e-4;
+
 /// One end of a boundary bracket: a depth (m) and its minimum altitude
 /// (m) when known.
 type End = (f32, Option<f32>);
@@ -32,6 +39,10 @@ type End = (f32, Option<f32>);
 pub(super) enum Decision<const N: usize> {
     /// Answered without the optimizer.
     Done(Flown<N>, Found),
+    /// Answered on the arrival's floor (m, the altitude the answer
+    /// clears): no depth clears the planner's margin over `h_a`, every
+    /// depth of the floor clears `h_a` ([`safest`]).
+    Floor(Flown<N>, f32),
     /// Optimize, from `z0` (with the scan's curvature unless `flat`).
     Optimize { z0: f32, flat: bool },
 }
@@ -44,20 +55,14 @@ pub(super) fn decide<const N: usize>(
     fl: &mut Flights<'_, '_, N>,
     scan: &ScanLog,
     vertex: f32,
-    h_safe: f32,
+    (h_a, h_safe): (f32, f32),
     steps: u32,
 ) -> Result<Decision<N>, PlanError> {
     match bracket(scan, vertex, h_safe) {
-        Bracket::Infeasible => {
-            let z = scan.safest().unwrap_or(vertex);
-            let (score, next) = fl.fly(z)?;
-            let f = Flown {
-                depth: z,
-                score,
-                next,
-            };
-            Ok(Decision::Done(f, Found::Infeasible(OptimizerStop::None)))
-        }
+        Bracket::Infeasible => match safest(fl, scan, (vertex, h_a), steps)? {
+            (f, Some(floor)) => Ok(Decision::Floor(f, floor)),
+            (f, None) => Ok(Decision::Done(f, Found::Infeasible(OptimizerStop::None))),
+        },
         Bracket::None => Ok(Decision::Optimize {
             z0: vertex,
             flat: false,
@@ -97,6 +102,62 @@ pub(super) fn decide<const N: usize>(
             }
         }
     }
+}
+
+/// No scanned depth is safe: the safest one. Where several share the
+/// safest altitude (within [`FLOOR`]) and it clears `h_a` (m: safe in the
+/// model, inside the planner's margin only), it is a floor the depth does
+/// not move (the track's least altitude set where it begins, by the
+/// arrival), and the answer is the least `J` on that floor: the scanned
+/// one, or the floor's edge by the boundary search towards a lower `J`
+/// beyond it. (Below `h_a` the first safest depth stays the answer: on the
+/// 256 random lines of BENCHMARKS.md, the least `J` on such a floor moved
+/// 85 unsafe lines track by track, 7 of them to lower flights later on.)
+/// Returns the answer and, where it is on such a floor, the floor (m).
+/// (`check_planner.py --seed 2530 --vehicle .../low.toml`,
+/// `unseen_2530_2` track 3: every depth down to 1 131.5 m leaves the track
+/// 28.0016 m above its bottom, 0.4 mm inside the margin; the first safest
+/// scanned depth, 987.4 m, was 6.7× the f64 best `J` at 1 131.5 m.)
+fn safest<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    scan: &ScanLog,
+    (vertex, h_a): (f32, f32),
+    steps: u32,
+) -> Result<(Flown<N>, Option<f32>), PlanError> {
+    let top = scan.iter().map(|e| e.1).fold(f32::NEG_INFINITY, f32::max);
+    let floor = top - FLOOR;
+    let on_floor = scan.iter().filter(|e| e.1 >= floor).count();
+    let z = scan.safest().unwrap_or(vertex);
+    if on_floor >= 2 && floor >= h_a {
+        match bracket(scan, vertex, floor) {
+            Bracket::Found(good, bad) => {
+                return Ok((boundary(fl, good, bad, floor, steps)?.at, Some(floor)));
+            }
+            Bracket::None => {
+                let least = scan
+                    .entries()
+                    .filter(|e| e.2 >= floor && e.1.is_finite())
+                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                if let Some((z_l, _, _)) = least {
+                    let (score, next) = fl.fly(z_l)?;
+                    let f = Flown {
+                        depth: z_l,
+                        score,
+                        next,
+                    };
+                    return Ok((f, Some(floor)));
+                }
+            }
+            Bracket::Infeasible => {}
+        }
+    }
+    let (score, next) = fl.fly(z)?;
+    let f = Flown {
+        depth: z,
+        score,
+        next,
+    };
+    Ok((f, None))
 }
 
 /// What the scan brackets.
