@@ -124,10 +124,13 @@ fn safest<const N: usize>(
     (vertex, h_a): (f32, f32),
     steps: u32,
 ) -> Result<(Flown<N>, Option<f32>), PlanError> {
-    let top = scan.iter().map(|e| e.1).fold(f32::NEG_INFINITY, f32::max);
+    let (z_safest, top) = scan
+        .iter()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .unwrap_or((vertex, f32::NEG_INFINITY));
     let floor = top - FLOOR;
     let on_floor = scan.iter().filter(|e| e.1 >= floor).count();
-    let z = scan.safest().unwrap_or(vertex);
+    let mut at = (z_safest, None);
     if on_floor >= 2 && floor >= h_a {
         match bracket(scan, vertex, floor) {
             Bracket::Found(good, bad) => {
@@ -139,25 +142,15 @@ fn safest<const N: usize>(
                     .filter(|e| e.2 >= floor && e.1.is_finite())
                     .min_by(|a, b| a.1.total_cmp(&b.1));
                 if let Some((z_l, _, _)) = least {
-                    let (score, next) = fl.fly(z_l)?;
-                    let f = Flown {
-                        depth: z_l,
-                        score,
-                        next,
-                    };
-                    return Ok((f, Some(floor)));
+                    at = (z_l, Some(floor));
                 }
             }
             Bracket::Infeasible => {}
         }
     }
-    let (score, next) = fl.fly(z)?;
-    let f = Flown {
-        depth: z,
-        score,
-        next,
-    };
-    Ok((f, None))
+    let (depth, kept) = at;
+    let (score, next) = fl.fly(depth)?;
+    Ok((Flown { depth, score, next }, kept))
 }
 
 /// What the scan brackets.
