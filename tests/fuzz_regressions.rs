@@ -317,6 +317,33 @@ fn rms_stays_finite() {
     }
 }
 
+/// Found by `simulate` (`fuzz/regressions/simulate/rms-subnormal-track`: a
+/// track 3·10⁻³⁹ m long, a subnormal length): `2 / L` overflowed to
+/// infinity, and the RMS of a finite, tiny `J` with it.
+#[test]
+fn rms_of_a_subnormal_track_stays_finite() {
+    let vehicle = Vehicle::c_auv4().unwrap();
+    let bottom = Profile::<4>::new(&[-1.704475e38, 2.3552217e-38], &[1.7014118e38, 0.0]).unwrap();
+    let waypoints = Waypoints::<4>::new(&[0.0, 3.030571e-39]).unwrap();
+    let line = Scenario::new(&vehicle, &bottom, &waypoints, Mission::default()).unwrap();
+    let start = line.start_state(line.default_initial_depth());
+    let mut scores = [TrackScore::default()];
+    let flown = line.simulate(
+        &start,
+        0,
+        &[line.default_initial_depth()],
+        &mut scores,
+        |_| {},
+    );
+    let s = scores[0];
+    assert!(
+        flown.is_err() || (s.j().is_finite() && s.rms().is_finite()),
+        "simulate returned Ok with J {} and RMS {}",
+        s.j(),
+        s.rms()
+    );
+}
+
 /// Found by `planner` (`fuzz/regressions/planner/integrator-overflow`): a
 /// depth gain `Kpd` of 3.6·10⁻⁴³ and a depth limit of −1.7·10³⁸ m let a
 /// reference of −1.7·10³⁸ m integrate into `I_d` unclamped: the depth

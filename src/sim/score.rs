@@ -56,8 +56,9 @@ impl TrackScore {
     }
     /// RMS deviation from the target depth `sqrt(2 J / (X_{i+1} − X_i))`, m.
     pub fn rms(&self) -> f32 {
-        // √J · √(2 / L): no overflow of `2 J` where `J` is near f32's range.
-        libm::sqrtf(self.j()) * libm::sqrtf(2.0 / (self.x_end - self.x_start))
+        // √J / √L · √2: no overflow of `2 J` where `J` is near f32's range,
+        // nor of `2 / L` where `L` is subnormal (√J / √L is about |e| / √2).
+        libm::sqrtf(self.j()) / libm::sqrtf(self.x_end - self.x_start) * core::f32::consts::SQRT_2
     }
     /// Constraint violation `½ ∫ max(0, h_p − h)² dx` by the same
     /// trapezoid, m³, with `h_p` the scenario's penalty altitude (`h_a`
