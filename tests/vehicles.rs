@@ -430,6 +430,19 @@ fn a_deep_start_raises_the_next_track_out_of_the_bottom() {
     horizon_within("lift_repair", 1.01, 1.245_461e7);
 }
 
+/// A freed start's deeper track with the next track raised out of the
+/// bottom (`check_planner.py --seed 3125 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_3125_3`): lifting track 2
+/// by 24 m freed track 3, whose deepest depth that clears its target
+/// (229.4 m, 100 m deeper) left track 4 far below its target; the start
+/// was not taken and the line's `J` was 4.968e6 m³, 1.101× the f64 beam
+/// search's best safe plan (4.511 173e6 m³). With track 4 raised to clear
+/// it, as the deepest depth's start already was, 1.0006×.
+#[test]
+fn a_freed_start_raises_the_next_track_out_of_the_bottom() {
+    horizon_within("freed_repair", 1.01, 4.511_173e6);
+}
+
 /// The committed depth polished where the depth loop integrates
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP
