@@ -240,3 +240,42 @@ fn the_resumable_planner_steps_within_its_flights() {
         std::mem::size_of::<Resumable<5>>()
     );
 }
+
+/// The iteration cap holds for every call, whatever it is: every shared
+/// line planned call after call in horizon mode, constrained and not, with
+/// caps of 1 to 8 iterations. (Found by the `planner` fuzz target,
+/// `fuzz/regressions/planner/iterations-over-cap`: an SQP restart given
+/// one iteration where none was left answered 7 iterations under a cap
+/// of 6.)
+#[test]
+fn no_call_passes_its_iteration_cap() {
+    let vehicle = Vehicle::c_auv4().unwrap();
+    for (name, h_r, h_a) in LINES {
+        let (map, wps) = line(name);
+        let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
+        let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
+        for cap in 1..=8 {
+            for constrained in [true, false] {
+                let mut cfg = PlannerConfig {
+                    constrained,
+                    ..PlannerConfig::default()
+                };
+                cfg.bfgs.max_iterations = cap;
+                let mut planner = Planner::<5>::new(cfg).unwrap();
+                let mut st = sc.start_state(sc.default_initial_depth());
+                for n in 0..sc.waypoints().tracks() {
+                    let Ok(p) = planner.plan(&sc, &st, n) else {
+                        break;
+                    };
+                    assert!(
+                        p.iterations <= cap,
+                        "{name}, cap {cap}, constrained {constrained}, track {}: {} iterations",
+                        n + 1,
+                        p.iterations
+                    );
+                    st = p.next_state;
+                }
+            }
+        }
+    }
+}

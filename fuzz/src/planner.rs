@@ -402,7 +402,7 @@ fn check_contract<const N: usize, const K: usize>(
     }
     assert!(
         plan.iterations <= cfg.bfgs.max_iterations,
-        "{} iterations, cap {}",
+        "{} iterations, cap {}: {plan:?}",
         plan.iterations,
         cfg.bfgs.max_iterations
     );

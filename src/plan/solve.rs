@@ -274,14 +274,19 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let kept = self.work.mark();
             let kept_v = obj.last_violation;
             let so_far = total.unwrap_or(iterations);
+            // (The restart's start counts as an iteration of the cap: with
+            // none left after it, no restart.)
+            let max_iterations = self
+                .cfg
+                .bfgs
+                .max_iterations
+                .saturating_sub(so_far)
+                .saturating_sub(1);
+            if max_iterations == 0 {
+                break;
+            }
             let left = BfgsConfig {
-                max_iterations: self
-                    .cfg
-                    .bfgs
-                    .max_iterations
-                    .saturating_sub(so_far)
-                    .saturating_sub(1)
-                    .max(1),
+                max_iterations,
                 ..self.cfg.bfgs
             };
             // (A fresh metric, `sqp_into`'s Gauss–Newton one.)
