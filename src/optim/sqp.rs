@@ -153,10 +153,12 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         }
         let before = run.iterations;
         let mut stop = run.iterate(obj, (bounds, n), cfg, feas_tol);
-        // Stuck infeasible: a restoration step, then on from there.
+        // Stuck infeasible: a restoration step (an iteration of the cap,
+        // where one is left), then on from there.
         if stop == Some(Status::LineSearchFailed)
             && run.lin.infeasibility > feas_tol
             && restorations < RESTORATIONS
+            && run.iterations < cfg.max_iterations
             && run.restore(obj, (bounds, n))
         {
             restorations = restorations.saturating_add(1);
