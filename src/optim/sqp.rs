@@ -134,6 +134,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         iterations: 0,
         skipped: 0,
         stalls: 0,
+        restorations: 0,
         careful,
         sliver: false,
     };
@@ -144,7 +145,6 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     }
     run.a = initial_metric(&run.lin.gn, n);
     let _ = out.history.push(run.lin.j);
-    let mut restorations = 0;
     let mut best = BestFeasible::default();
     best.see(&run.z, &run.lin, feas_tol);
     let status = loop {
@@ -152,19 +152,8 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
             break Status::MaxIterations;
         }
         let before = run.iterations;
-        let mut stop = run.iterate(obj, (bounds, n), cfg, feas_tol);
-        // Stuck infeasible: a restoration step (an iteration of the cap,
-        // where one is left), then on from there.
-        if stop == Some(Status::LineSearchFailed)
-            && run.lin.infeasibility > feas_tol
-            && restorations < RESTORATIONS
-            && run.iterations < cfg.max_iterations
-            && run.restore(obj, (bounds, n))
-        {
-            restorations = restorations.saturating_add(1);
-            run.stalls = 0;
-            stop = None;
-        }
+        let stop = run.iterate(obj, (bounds, n), cfg, feas_tol);
+        let stop = run.unstuck(obj, (bounds, n), stop, (feas_tol, cfg.max_iterations));
         // One value per completed iteration, the last included.
         if run.iterations != before {
             let _ = out.history.push(run.lin.j);
@@ -239,6 +228,8 @@ struct Run<const K: usize> {
     skipped: u32,
     /// Infeasible iterations in a row that left the merit unmoved.
     stalls: u32,
+    /// Restorations made (at most [`RESTORATIONS`]).
+    restorations: u32,
     /// Whether the QP also takes the rows beyond the band its step would
     /// cross.
     careful: bool,
@@ -361,6 +352,29 @@ impl<const K: usize> Run<K> {
 }
 
 impl<const K: usize> Run<K> {
+    /// After an iteration that ended the run with `stop`: stuck infeasible
+    /// (the line search failed beyond `feas_tol`, m), a restoration step
+    /// ([`Run::restore`], an iteration of the cap where one is left), and
+    /// the run goes on (`None`); else `stop`.
+    fn unstuck<O: Constrained<K>>(
+        &mut self,
+        obj: &mut O,
+        (bounds, n): (&Bounds<K>, usize),
+        stop: Option<Status>,
+        (feas_tol, cap): (f32, u32),
+    ) -> Option<Status> {
+        let stuck = stop == Some(Status::LineSearchFailed)
+            && self.lin.infeasibility > feas_tol
+            && self.restorations < RESTORATIONS
+            && self.iterations < cap;
+        if !(stuck && self.restore(obj, (bounds, n))) {
+            return stop;
+        }
+        self.restorations = self.restorations.saturating_add(1);
+        self.stalls = 0;
+        None
+    }
+
     /// Feasibility restoration (N&W §18.4's spirit, without `J`): the
     /// least step in the Euclidean norm onto the linearized constraints,
     /// halved where it makes `v` no smaller and extended along the secant
