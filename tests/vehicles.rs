@@ -443,6 +443,19 @@ fn a_freed_start_raises_the_next_track_out_of_the_bottom() {
     horizon_within("freed_repair", 1.01, 4.511_173e6);
 }
 
+/// The cold call's escapes owed to the next call where the cold call
+/// ended infeasible (`check_planner.py --seed 2534 --vehicle
+/// tools/reference/vehicles/second.toml`, `unseen_2534_4`): the cold SQP
+/// ended infeasible within the band, where the escapes (the lift, the held
+/// edge) do not run, and the warm calls kept its continuation: track 3 at
+/// 207.9 m, 16.6e6 m³. The line's `J` was 2.684e7 m³, 1.20× the f64 beam
+/// search's best safe plan (2.237 104e7 m³); with the escapes run by the
+/// second call (the held edge takes track 3 to 469.7 m), 1.0003×.
+#[test]
+fn escapes_owed_by_an_infeasible_cold_call_run_in_the_next() {
+    horizon_within("escapes_owed", 1.01, 2.237_104e7);
+}
+
 /// The committed depth polished where the depth loop integrates
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP

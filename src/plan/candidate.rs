@@ -155,7 +155,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         self.committed_to_boundary(&mut obj, (s.h, &s.bounds));
         let last = obj.last_flight;
-        let (answer, warm) = ((iterations, None), (obj.mu, 0));
+        let (answer, warm) = ((iterations, None), (obj.mu, 0, false));
         self.finish((&mut fl, &s, &mut scan), (&obj, last), answer, warm)
     }
 
@@ -171,7 +171,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             Option<(f32, TrackScore, VehicleState<N>)>,
         ),
         (iterations, previous_j): (u32, Option<f32>),
-        warm: (f32, u64),
+        warm: (f32, u64, bool),
     ) -> Result<Candidate<N>, PlanError> {
         fl.count = fl.count.saturating_add(obj.evaluations);
         let spent = obj.evaluations >= obj.budget;
@@ -259,18 +259,17 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             tol,
             (skip, s.warm.is_none() && !declared),
         )?;
-        if s.warm.is_none() {
-            let at = (tol, s.h_safe, iterations);
-            let wide = (s.h, &s.bounds, s.mu);
-            iterations = self.cold_escapes((&mut obj, fl, scan), wide, at);
-        }
+        let (at, wide) = ((tol, s.h_safe, iterations), (s.h, &s.bounds, s.mu));
+        let due = s.warm.is_none_or(|w| w.escapes);
+        let (escaped, owed) = self.due_escapes((&mut obj, fl, scan), wide, at, due);
+        iterations = escaped;
         self.polish_first(&mut obj, (s.h, &s.bounds), tol);
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {
             iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), (tol, s.h_safe))?;
         }
         let answer = (iterations, previous_j);
-        self.finish((fl, s, scan), (&obj, None), answer, (0.0, plateaus))
+        self.finish((fl, s, scan), (&obj, None), answer, (0.0, plateaus, owed))
     }
 
     /// The scan's decision of a constrained single track (module docs of
@@ -401,7 +400,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         let last = obj.last_flight;
         let answer = (self.work.iterations, None);
-        self.finish((fl, s, scan), (obj, last), answer, (obj.mu, 0))
+        self.finish((fl, s, scan), (obj, last), answer, (obj.mu, 0, false))
             .map(Some)
     }
 
@@ -546,7 +545,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// Keeps the rest of the horizon for the next call (horizon mode).
-    fn keep_warm(&mut self, track: usize, h: usize, depth: f32, (mu, plateaus): (f32, u64)) {
+    fn keep_warm(&mut self, track: usize, h: usize, depth: f32, warm: (f32, u64, bool)) {
+        let (mu, plateaus, escapes) = warm;
         if let Some(first) = self.work.z.first_mut() {
             *first = depth;
         }
@@ -561,6 +561,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 len: h.saturating_sub(1),
                 mu,
                 plateaus: plateaus >> 1,
+                escapes,
             }
         });
     }

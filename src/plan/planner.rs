@@ -68,6 +68,9 @@ pub(super) struct Warm<const K: usize> {
     /// Horizon positions (bit `j`: `track + j`) whose plateau the previous
     /// call's SQP scanned already (`solve.rs`).
     pub plateaus: u64,
+    /// The previous call was due the cold call's escapes (`wider.rs`) and
+    /// ended infeasible, where they do not run: this call runs them.
+    pub escapes: bool,
 }
 
 /// Reference depths for the tracks `track..track + len`, m.

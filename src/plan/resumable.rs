@@ -114,6 +114,7 @@ impl<const K: usize, const N: usize> Resumable<K, N> {
                 len: b.horizon_len,
                 mu: b.warm.map_or(b.cfg.penalty_weight, |w| w.mu),
                 plateaus: 0,
+                escapes: false,
             });
         }
         let plan = attempt.plan(sc, &state, track)?;

@@ -87,7 +87,19 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// the lift from the SQP's end finds 42 % less: the line went from
     /// 1.0009× to 1.63× the f64 search's best safe `J`.) Arguments as
     /// [`Planner::wider_start`]'s; returns the iterations so far.
-    pub(super) fn cold_escapes(
+    ///
+    /// A cold call that ends infeasible (beyond `tol`) runs only the first
+    /// of them (the others start from a feasible end), and owes them to
+    /// the next call, which runs them from its own end (`Warm::escapes`),
+    /// and so on until a call ends feasible. On `check_planner.py --seed
+    /// 2534 --vehicle tools/reference/vehicles/second.toml`
+    /// (`unseen_2534_4`) the cold call ended infeasible within the band
+    /// and the warm calls kept its continuation: 1.20× the f64 best safe
+    /// `J`; the second call's held edge takes it to 1.0003×. On 267 random
+    /// lines 17 move, none higher (13 of them lines with no safe plan
+    /// found either way), 11.6 flights a line more; the 24 shared runs
+    /// the same plans and flights (their cold calls end feasible).
+    fn cold_escapes(
         &mut self,
         (obj, fl, scan): (&mut PlanObjective<'_, N>, &mut Flights<'_, '_, N>, &ScanLog),
         (h, bounds, mu): (usize, &Bounds<K>, f32),
@@ -111,6 +123,25 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             None => iterations,
         };
         self.stride_first(obj, (h, bounds), tol, iterations)
+    }
+
+    /// [`Planner::cold_escapes`] where they are `due` (a cold call's, or
+    /// owed by the call before, `Warm::escapes`), arguments as theirs;
+    /// returns the iterations so far and whether the next call owes them
+    /// (this one was due and ended infeasible beyond `tol`).
+    pub(super) fn due_escapes(
+        &mut self,
+        (obj, fl, scan): (&mut PlanObjective<'_, N>, &mut Flights<'_, '_, N>, &ScanLog),
+        (h, bounds, mu): (usize, &Bounds<K>, f32),
+        (tol, h_safe, iterations): (f32, f32, u32),
+        due: bool,
+    ) -> (u32, bool) {
+        if !due {
+            return (iterations, false);
+        }
+        let at = (tol, h_safe, iterations);
+        let iterations = self.cold_escapes((obj, fl, scan), (h, bounds, mu), at);
+        (iterations, obj.last_violation > tol)
     }
 
     /// The lift (`lift.rs`), then the held edge (`jump.rs`, `held_last`),

@@ -175,6 +175,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             len: h,
             mu,
             plateaus: 0,
+            escapes: false,
         });
     }
 
@@ -290,6 +291,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 len: warm_len,
                 mu: self.cfg.penalty_weight,
                 plateaus: 0,
+                escapes: false,
             }
         });
     }
