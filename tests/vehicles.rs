@@ -283,6 +283,20 @@ fn a_plateau_past_a_ridge_is_left() {
     track_within("ridge_plateau", &UNCONSTRAINED, &[], 0, 134_234.0);
 }
 
+/// A plateau whose edge `J` falls off gently (`check_planner.py --seed
+/// 2544`, default vehicle, `unseen_2544_2`, track 4, unconstrained): `J`
+/// is flat deeper than about 781.8 m and falls off it by 11 m³ at the
+/// first depth found past the edge, under BFGS's stopping threshold
+/// (93 m³), so the
+/// restart from the edge stopped at once: 781.80 m, `J` 9.2704e6 m³,
+/// 1.007× the f64 best 9.206 37e6 m³ (722.6 m). Now from a point further
+/// out, where `J` has fallen by more than the threshold.
+#[test]
+fn a_plateau_with_a_gentle_edge_is_left() {
+    let premise = [(0, 405.398), (1, 287.756), (2, 435.351)];
+    track_within("gentle_edge", &UNCONSTRAINED, &premise, 3, 9.206_37e6);
+}
+
 /// A freed start whose `J` is above the SQP's (`check_planner.py --seed
 /// 2006 --vehicle tools/reference/vehicles/second.toml`, `unseen_2006_5`):
 /// the cold SQP ended with track 3 held at its target by track 2's depth;
