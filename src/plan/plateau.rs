@@ -71,9 +71,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return Ok(iterations);
         }
         let (flat, mut start) = (w.j, w.z);
-        let cap = self.cfg.bfgs.max_iterations;
+        let (cap, thr) = (
+            self.cfg.bfgs.max_iterations,
+            self.cfg.bfgs.tol.j_threshold(flat),
+        );
         for dir in [1.0_f32, -1.0] {
-            let thr = self.cfg.bfgs.tol.j_threshold(flat);
             let Some(edge) = plateau_edge(obj, (lo, hi), (z, flat, thr), dir, &mut start) else {
                 continue;
             };
