@@ -1024,13 +1024,17 @@ fn a_crash_does_not_end_the_planning() {
 /// (223.3 m, least altitude −1.5 m), 68.8 m, with `J_5` 5.71e6 m³. With the
 /// first four tracks at the tool's depths (asserted: the premise), the f64
 /// reference (`auvref.evaluate_plan`, `z_5` scanned every 5 cm) finds the
-/// best safe `J_5` 2.319 15e6 m³ at 137.15 m (least altitude 60.004 m).
+/// best safe `J_5` 2.222 16e6 m³ at 139.60 m (least altitude 60.016 m).
+/// (Since the escapes owed by a cold call that ends infeasible, its
+/// second call runs them: tracks 2–4 moved (147.12, 141.34, 169.79 m
+/// before, where the best safe `J_5` was 2.319 15e6 m³ at 137.15 m), the
+/// line's `J` 1.4901e7 → 1.4792e7 m³.)
 #[test]
 fn a_warm_last_track_stays_by_its_boundary() {
     let (p, w, _) = fixture("warm_last");
     let v = json_of(&["--profile", &p, "--waypoints", &w, "--json"]);
     let tracks = v["tracks"].as_array().unwrap();
-    let head = [110.21864, 147.11755, 141.34277, 169.78854];
+    let head = [110.2067, 147.15475, 148.12071, 167.92351];
     for (t, z) in tracks.iter().zip(head) {
         let d = t["depth"].as_f64().unwrap();
         // (Within 15 cm: where an optimizer stops moves by centimetres
@@ -1041,8 +1045,8 @@ fn a_warm_last_track_stays_by_its_boundary() {
     let j5 = t5["J"].as_f64().unwrap();
     assert_eq!(t5["safe"], true, "{t5}");
     assert!(
-        j5 <= 1.01 * 2.319_15e6,
-        "track 5: J {j5} vs the best safe 2.319 15e6 at 137.15 m"
+        j5 <= 1.01 * 2.222_16e6,
+        "track 5: J {j5} vs the best safe 2.222 16e6 at 139.60 m"
     );
 }
 
