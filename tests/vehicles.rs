@@ -470,6 +470,20 @@ fn escapes_owed_by_an_infeasible_cold_call_run_in_the_next() {
     horizon_within("escapes_owed", 1.01, 2.237_104e7);
 }
 
+/// A lift's start at the later track's preferred depth, feasible,
+/// ranked as a freed one (`check_planner.py --seed 2550 --vehicle
+/// tools/reference/vehicles/slow.toml`, `unseen_2550_6`): the cold SQP
+/// ended with track 3 held at its target by track 2 (1 140 m); lifting
+/// track 2 by 110 m lets track 3 fly its preferred depth (1 231 m), every
+/// track within the band of its target, at 1.04× the SQP's horizon `J`, and a
+/// start at the preferred depth was restarted only where it was lower.
+/// The line's `J` was 4.645e6 m³, 1.136× the f64 beam search's best safe
+/// plan (4.090 65e6 m³); restarted, 1.0009×.
+#[test]
+fn a_feasible_start_at_the_preferred_depth_is_restarted() {
+    horizon_within("deep_feasible", 1.01, 4.090_65e6);
+}
+
 /// The committed depth polished where the depth loop integrates
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP
