@@ -475,8 +475,9 @@ fn escapes_owed_by_an_infeasible_cold_call_run_in_the_next() {
 /// tools/reference/vehicles/slow.toml`, `unseen_2550_6`): the cold SQP
 /// ended with track 3 held at its target by track 2 (1 140 m); lifting
 /// track 2 by 110 m lets track 3 fly its preferred depth (1 231 m), every
-/// track within the band of its target, at 1.04× the SQP's horizon `J`, and a
-/// start at the preferred depth was restarted only where it was lower.
+/// track within the band of its target, at 1.04× the SQP's horizon `J`,
+/// and a start at the preferred depth was restarted only where it was
+/// lower.
 /// The line's `J` was 4.645e6 m³, 1.136× the f64 beam search's best safe
 /// plan (4.090 65e6 m³); restarted, 1.0009×.
 #[test]
