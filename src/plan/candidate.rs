@@ -261,8 +261,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         )?;
         let (at, wide) = ((tol, s.h_safe, iterations), (s.h, &s.bounds, s.mu));
         let due = s.warm.is_none_or(|w| w.escapes);
-        let (escaped, owed) = self.due_escapes((&mut obj, fl, scan), wide, at, due);
-        iterations = escaped;
+        iterations = self.cold_escapes((&mut obj, fl, scan), wide, at, due);
+        let owed = due && obj.last_violation > tol;
         self.polish_first(&mut obj, (s.h, &s.bounds), tol);
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {

@@ -98,13 +98,18 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `J`; the second call's held edge takes it to 1.0003×. On 267 random
     /// lines 17 move, none higher (13 of them lines with no safe plan
     /// found either way), 11.6 flights a line more; the 24 shared runs
-    /// the same plans and flights (their cold calls end feasible).
-    fn cold_escapes(
+    /// the same plans and flights (their cold calls end feasible). None
+    /// where they are not `due` (a warm call owed nothing).
+    pub(super) fn cold_escapes(
         &mut self,
         (obj, fl, scan): (&mut PlanObjective<'_, N>, &mut Flights<'_, '_, N>, &ScanLog),
         (h, bounds, mu): (usize, &Bounds<K>, f32),
         (tol, h_safe, iterations): (f32, f32, u32),
+        due: bool,
     ) -> u32 {
+        if !due {
+            return iterations;
+        }
         let at = (tol, h_safe, iterations);
         let mut iterations = self
             .wider_start((obj, fl, scan), (h, bounds, mu), at, false)
@@ -123,25 +128,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             None => iterations,
         };
         self.stride_first(obj, (h, bounds), tol, iterations)
-    }
-
-    /// [`Planner::cold_escapes`] where they are `due` (a cold call's, or
-    /// owed by the call before, `Warm::escapes`), arguments as theirs;
-    /// returns the iterations so far and whether the next call owes them
-    /// (this one was due and ended infeasible beyond `tol`).
-    pub(super) fn due_escapes(
-        &mut self,
-        (obj, fl, scan): (&mut PlanObjective<'_, N>, &mut Flights<'_, '_, N>, &ScanLog),
-        (h, bounds, mu): (usize, &Bounds<K>, f32),
-        (tol, h_safe, iterations): (f32, f32, u32),
-        due: bool,
-    ) -> (u32, bool) {
-        if !due {
-            return (iterations, false);
-        }
-        let at = (tol, h_safe, iterations);
-        let iterations = self.cold_escapes((obj, fl, scan), (h, bounds, mu), at);
-        (iterations, obj.last_violation > tol)
     }
 
     /// The lift (`lift.rs`), then the held edge (`jump.rs`, `held_last`),
