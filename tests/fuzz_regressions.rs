@@ -300,15 +300,7 @@ fn rms_stays_finite() {
     let waypoints = Waypoints::<8>::new(&[-2627.4512, -2589.351]).unwrap();
     let line = Scenario::new(&vehicle, &bottom, &waypoints, Mission::default()).unwrap();
     let start = line.start_state(2.9904567e18);
-    let mut scores = [TrackScore::default()];
-    let flown = line.simulate(&start, 0, &[6000.0], &mut scores, |_| {});
-    let s = scores[0];
-    assert!(
-        flown.is_err() || (s.j().is_finite() && s.rms().is_finite()),
-        "simulate returned Ok with J {} and RMS {}",
-        s.j(),
-        s.rms()
-    );
+    assert_one_track_finite(&line, &start, 6000.0);
     let plan = Planner::<1>::new(PlannerConfig::default())
         .unwrap()
         .plan(&line, &start, 0);
@@ -327,14 +319,14 @@ fn rms_of_a_subnormal_track_stays_finite() {
     let waypoints = Waypoints::<4>::new(&[0.0, 3.030571e-39]).unwrap();
     let line = Scenario::new(&vehicle, &bottom, &waypoints, Mission::default()).unwrap();
     let start = line.start_state(line.default_initial_depth());
+    assert_one_track_finite(&line, &start, line.default_initial_depth());
+}
+
+/// Track 1 of `line` flown from `start` at depth `z` (m): a typed error, or
+/// a finite `J` and RMS.
+fn assert_one_track_finite(line: &Scenario<'_, 3>, start: &VehicleState<3>, z: f32) {
     let mut scores = [TrackScore::default()];
-    let flown = line.simulate(
-        &start,
-        0,
-        &[line.default_initial_depth()],
-        &mut scores,
-        |_| {},
-    );
+    let flown = line.simulate(start, 0, &[z], &mut scores, |_| {});
     let s = scores[0];
     assert!(
         flown.is_err() || (s.j().is_finite() && s.rms().is_finite()),
