@@ -73,6 +73,19 @@ fn a_bump_of_the_teeth_is_looked_past() {
     track_within("tooth_bump", &UNCONSTRAINED, &premise, 3, 9_993.61);
 }
 
+/// A basin past a bump of the wiggles (`check_planner.py --seed 2560
+/// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2560_6`, track
+/// 5, unconstrained): BFGS ended at 260.67 m, `J` 4.29570e5 m³, in a
+/// dip of `J`'s wiggles; half a metre and 2 m to either side are higher
+/// (the bump peaks at 263 m), so neither look of the polish moved it:
+/// 1.0052× the f64 best 4.27358e5 m³ (266.115 m, from the tool's track
+/// 4). The polish's widest look (8 m) finds the basin.
+#[test]
+fn a_basin_past_a_bump_is_looked_for_wider() {
+    let premise = [(0, 715.652), (1, 538.295), (2, 381.286), (3, 117.752)];
+    track_within("far_basin", &UNCONSTRAINED, &premise, 4, 4.273_58e5);
+}
+
 /// A concave stretch (`check_planner.py --seed 1404 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_1404_5`, track 2): `J`
 /// fell at least linearly along each step, the curvature guard skipped
