@@ -49,6 +49,21 @@ fn a_crawl_down_a_sawtooth_is_cut_short() {
     assert!(it <= 10, "track 1: {it} iterations");
 }
 
+/// A crawl into a vee (`check_planner.py --seed 2559 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2559_2`, track 2,
+/// unconstrained): `J` has a kink at its minimum, 675.08 m, where the
+/// gradient on the shallower side is still −51 m². Every first trial
+/// landed past the kink and the step fell to a tenth: 11 iterations, `J`
+/// falling 41, 10, 5, 3, 2 … m³ each, over the checker's 10. The trials
+/// rejected past the kink now put a cap on the step (`optim/vee.rs`).
+/// The f64 best: 23 344.2 m³ (675.084 m).
+#[test]
+fn a_crawl_into_a_vee_is_cut_short() {
+    let t = track_within("vee", &UNCONSTRAINED, &[(0, 731.494)], 1, 23_344.2);
+    let it = t["iterations"].as_u64().unwrap();
+    assert!(it <= 10, "track 2: {it} iterations");
+}
+
 /// A quiet tooth (`check_planner.py --seed 2418 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_2418_4`, track 3): BFGS
 /// stopped at 420.68 m, `J` 2.2957e6 m³, 9 m short of the basin, on a

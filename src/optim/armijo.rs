@@ -35,6 +35,11 @@ pub(crate) struct Trial<const K: usize> {
     pub j: f32,
     /// Gradient there.
     pub g: Vector<K>,
+    /// The last trial rejected before this one (the shortest rejected
+    /// step) and its objective, `J` at least as high as the test allowed
+    /// (∞ where its flight failed); `None` where the first trial was
+    /// accepted.
+    pub rejected: Option<(Vector<K>, f32)>,
 }
 
 /// A line search: finds an acceptable point along a direction.
@@ -138,6 +143,7 @@ impl<const K: usize> LineSearch<K> for Armijo {
         evals: &mut u32,
     ) -> Option<Trial<K>> {
         let mut alpha = 1.0_f32;
+        let mut rejected = None;
         for _ in 0..=self.max_backtracks {
             let zt = bounds.project_v(&(z + dir * alpha));
             let step = zt - z;
@@ -161,6 +167,7 @@ impl<const K: usize> LineSearch<K> for Armijo {
             };
             if let Some(jt) = cheap {
                 alpha *= self.reduction(j, jt, slope);
+                rejected = Some((zt, jt));
                 continue;
             }
             let jt = match eval(obj, &zt) {
@@ -170,6 +177,7 @@ impl<const K: usize> LineSearch<K> for Armijo {
                             z: zt,
                             j: jt,
                             g: gt,
+                            rejected,
                         });
                     }
                     jt
@@ -177,6 +185,7 @@ impl<const K: usize> LineSearch<K> for Armijo {
                 _ => f32::INFINITY,
             };
             alpha *= self.reduction(j, jt, slope);
+            rejected = Some((zt, jt));
         }
         None
     }

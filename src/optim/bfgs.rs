@@ -45,10 +45,16 @@
 //!   (a depth loop that integrates conditionally makes it a sawtooth of
 //!   teeth centimetres wide, `plan/polish.rs`), every longer step lands
 //!   past a jump, and the run would crawl a few parts in 10⁵ of `J` an
-//!   iteration at the cost of a dozen halvings each.
+//!   iteration at the cost of a dozen halvings each;
+//! - **vee**: with one free variable, after a line search that
+//!   backtracked, the step is capped where the tangent at the point meets
+//!   the secant through the last two rejected trials beyond it, the
+//!   estimate of a kink at the minimum that every longer first trial
+//!   overshoots ([`super::vee`]).
 
 use nalgebra::SMatrix;
 
+use super::vee::Vee;
 use super::{
     Armijo, Bounds, LineSearch, Objective, OptimConfigError, OptimError, Outcome, Status,
     Tolerances, Vector, dot, norm, start,
@@ -215,6 +221,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut skipped_updates = 0_u32;
     let mut iterations = 0_u32;
     let mut slivers = 0_u32;
+    let mut vee = Vee::default();
 
     let status = loop {
         let grad_norm = bounds.free_gradient_norm_v(&z, &g);
@@ -249,6 +256,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         } else {
             dir
         };
+        let dir = vee.cap((&z, j, &g), dir);
         // Model-predicted decrease below the 3.14b threshold: converged
         // without spending an evaluation on a step that cannot matter.
         if -0.5 * dot(&g, &dir) <= cfg.tol.j_threshold(j) {
@@ -257,6 +265,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         let Some(t) = line_search.search(obj, bounds, &z, j, &g, &dir, &mut evaluations) else {
             break Status::LineSearchFailed;
         };
+        vee.record((&t.z, &t.g), &dir, t.rejected.as_ref());
         let dz = t.z - z;
         let y = t.g - g;
         let yd = dot(&y, &dz);
@@ -407,6 +416,7 @@ mod tests {
                 z: zt,
                 j,
                 g: SVector::from(g),
+                rejected: None,
             })
         }
     }

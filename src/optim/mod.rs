@@ -22,6 +22,7 @@ pub(crate) mod qp;
 pub(crate) mod root;
 pub(crate) mod sqp;
 pub(crate) mod step;
+pub(crate) mod vee;
 
 use core::fmt;
 
