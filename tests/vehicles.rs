@@ -513,6 +513,21 @@ fn a_feasible_start_at_the_preferred_depth_is_restarted() {
     horizon_within("deep_feasible", 1.01, 4.090_65e6);
 }
 
+/// A launch from the surface (`check_planner.py --seed 2542 --vehicle
+/// tools/reference/vehicles/stiff.toml`, `unseen_2542_5`): a seamount
+/// 226 m deep on track 3. The best safe plan climbs to the surface on
+/// track 2 and dives over the seamount on track 3. The lift of track 2
+/// reached the surface with track 3 at its preferred depth still 1.07 m
+/// short of its target (59.01 m, set by the arrival), and no start was
+/// made; the line's `J` was 8.743e7 m³, 4.60× the f64 beam search's best
+/// safe plan (1.900 07e7 m³). The start at the surface, within the band
+/// of feasible, is now restarted, and the SQP's restoration lifts track 1
+/// the metre it needs: 0.999×.
+#[test]
+fn a_lift_that_reaches_the_surface_is_restarted() {
+    horizon_within("surface_launch", 1.01, 1.900_07e7);
+}
+
 /// The committed depth polished where the depth loop integrates
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP
