@@ -50,7 +50,7 @@
 //!   backtracked, the step is capped where the tangent at the point meets
 //!   the secant through the last two rejected trials beyond it, the
 //!   estimate of a kink at the minimum that every longer first trial
-//!   overshoots ([`super::vee`]).
+//!   overshoots (`optim/vee.rs`).
 
 use nalgebra::SMatrix;
 

@@ -77,7 +77,7 @@ impl Vee {
         points.sort_unstable_by(|a, b| by_distance(a).total_cmp(&by_distance(b)));
         let [near, far, _] = points;
         // Two points at one depth give no secant.
-        let far = far.filter(|f| near.is_some_and(|n| n.0 != f.0));
+        let far = far.filter(|f| near.is_some_and(|n| libm::fabsf(n.0 - f.0) > 0.0));
         *self = Self {
             axis,
             near,
