@@ -51,7 +51,6 @@ impl Vee {
         dir: &Vector<K>,
         rejected: Option<&(Vector<K>, f32)>,
     ) {
-        self.backtracked = rejected.is_some();
         let Some(axis) = lone_axis(dir) else {
             *self = Self::default();
             return;
@@ -82,7 +81,7 @@ impl Vee {
             axis,
             near,
             far,
-            backtracked: self.backtracked,
+            backtracked: rejected.is_some(),
         };
     }
 
