@@ -528,6 +528,19 @@ fn a_lift_that_reaches_the_surface_is_restarted() {
     horizon_within("surface_launch", 1.01, 1.900_07e7);
 }
 
+/// The lift once more after the escapes (`check_planner.py --seed 2574
+/// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2574_1`): the
+/// lift ran from the SQP's end (track 1 at 945 m, `J` 5.0e6 m³), where no
+/// lift freed track 4; the later escapes took the plan to 1.0e6 m³ with
+/// track 4 held by track 3, and the lift did not run again: the line's
+/// `J` was 1.186× the f64 beam search's best safe plan (9.006 95e5 m³).
+/// Lifted again, 1.082× (the rest of the gap: track 3 at 1 020 m against
+/// the best plan's 1 014 m).
+#[test]
+fn the_lift_runs_again_where_the_escapes_moved_the_plan() {
+    horizon_within("lift_again", 1.09, 9.006_95e5);
+}
+
 /// The committed depth polished where the depth loop integrates
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP

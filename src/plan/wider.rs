@@ -72,14 +72,20 @@ use super::scan::{BEAM_HELD, BEAM_WIDE, ScanLog, ScanSpec, scan_start};
 /// times `h_r` is held (module docs).
 const HELD: f32 = 1.5;
 
+/// The share of the horizon's `J` where the lift first ran below which
+/// the escapes' end has the lift and the held edge run again.
+const AGAIN: f32 = 0.8;
+
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// A cold call's escapes after its SQP, in order: the wide beam where
     /// the SQP ended infeasible by more than the band; then, without
     /// declared uncertainty, the lift (`lift.rs`) and the held edge
     /// (`jump.rs`, `held_last`); then the wide beam where a track of that
     /// end is held far above its bottom, and where that restart is kept,
-    /// the lift and the held edge again from it; last, the first depth's
-    /// stride (`stride.rs`). (The held track's restart
+    /// the lift and the held edge again from it; then the first depth's
+    /// stride (`stride.rs`); last, where those took the horizon's `J`
+    /// below [`AGAIN`] of where the lift first ran, the lift and the held
+    /// edge once more (`lift.rs`' module docs). (The held track's restart
     /// first ran before the lift, kept where it beat the SQP's end: on
     /// `check_planner.py --seed 2002 --vehicle
     /// tools/reference/vehicles/integ.toml`, `unseen_2002_0`, it took
@@ -121,13 +127,20 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if obj.declared() {
             return iterations;
         }
+        let lifted_at = self.work.j;
         iterations = self.lift_then_held(obj, (h, bounds), tol, iterations);
         let at = (tol, h_safe, iterations);
         let iterations = match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
             Some(it) => self.lift_then_held(obj, (h, bounds), tol, it),
             None => iterations,
         };
-        self.stride_first(obj, (h, bounds), tol, iterations)
+        let iterations = self.stride_first(obj, (h, bounds), tol, iterations);
+        // The lift and the held edge once more where the escapes took `J`
+        // well below where they ran (module docs of `lift.rs`).
+        if self.work.j < AGAIN * lifted_at {
+            return self.lift_then_held(obj, (h, bounds), tol, iterations);
+        }
+        iterations
     }
 
     /// The lift (`lift.rs`), then the held edge (`jump.rs`, `held_last`),
