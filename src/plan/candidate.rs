@@ -266,7 +266,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.polish_first(&mut obj, (s.h, &s.bounds), tol);
         let previous_j = self.work.history.first().copied().filter(|_| from_previous);
         if certifying {
-            iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), (tol, s.h_safe))?;
+            let at = (tol, s.h_safe, iterations);
+            iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), at)?;
         }
         let answer = (iterations, previous_j);
         self.finish((fl, s, scan), (&obj, None), answer, (0.0, plateaus, owed))

@@ -128,17 +128,20 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The SQP's targets raised by the certification gaps of the horizon
     /// (module docs), re-solving from the workspace's point; `tol` is the
-    /// boundary tolerance (m), `h_safe` the certified altitude (m). Returns
-    /// the call's iterations so far. Nothing when the nominal flight over
-    /// the map is the certificate.
+    /// boundary tolerance (m), `h_safe` the certified altitude (m), after
+    /// the call's `iterations` so far (the workspace's count is only its
+    /// last run's, where the escapes restarted). Returns the call's
+    /// iterations so far. Nothing when the nominal flight over the map is
+    /// the certificate.
     pub(super) fn close_gaps(
         &mut self,
         sc: &Scenario<'_, N>,
         obj: &mut PlanObjective<'_, N>,
         (h, bounds): (usize, &Bounds<K>),
-        (tol, h_safe): (f32, f32),
+        (tol, h_safe, mut iterations): (f32, f32, u32),
     ) -> Result<u32, PlanError> {
-        let mut iterations = self.work.iterations;
+        // (A re-solve below chains its count onto the workspace's.)
+        self.work.iterations = iterations;
         let Some(mask) = self.screening(sc, obj)? else {
             return Ok(iterations);
         };
