@@ -254,28 +254,62 @@ fn no_call_passes_its_iteration_cap() {
         let (map, wps) = line(name);
         let mission = Mission::new(h_r, h_a, [0.0, 6000.0]).unwrap();
         let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
-        for cap in 1..=8 {
-            for constrained in [true, false] {
-                let mut cfg = PlannerConfig {
-                    constrained,
-                    ..PlannerConfig::default()
-                };
-                cfg.bfgs.max_iterations = cap;
-                let mut planner = Planner::<5>::new(cfg).unwrap();
-                let mut st = sc.start_state(sc.default_initial_depth());
-                for n in 0..sc.waypoints().tracks() {
-                    let Ok(p) = planner.plan(&sc, &st, n) else {
-                        break;
-                    };
-                    assert!(
-                        p.iterations <= cap,
-                        "{name}, cap {cap}, constrained {constrained}, track {}: {} iterations",
-                        n + 1,
-                        p.iterations
-                    );
-                    st = p.next_state;
-                }
-            }
+        for constrained in [true, false] {
+            within_every_cap(&sc, name, constrained);
+        }
+    }
+}
+
+/// The same under declared uncertainty, where the certification gaps
+/// re-solve the horizon: those re-solves were not held to the cap
+/// (Monterey 1 with the README's deep declaration, cap 1: 5 iterations).
+#[test]
+fn no_certified_call_passes_its_iteration_cap() {
+    let vehicle = Vehicle::c_auv4().unwrap();
+    for (name, h_r, h_a) in LINES {
+        let (map, wps) = line(name);
+        // The README's declarations (`deep_declared.toml`,
+        // `shallow_declared.toml`).
+        let u = if h_r > 10.0 {
+            Uncertainty::new(5.0, 0.0011, 6.0, 0.03, 0.5, 0.04)
+        } else {
+            Uncertainty::new(1.0, 0.0011, 0.3, 0.03, 0.5, 0.015)
+        }
+        .unwrap();
+        let env = lower_envelope::<12288>(map.view(), &u, wps.positions()[0]).unwrap();
+        let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
+            .unwrap()
+            .with_uncertainty(u);
+        let sc = Scenario::new(&vehicle, &map, &wps, mission)
+            .unwrap()
+            .with_certification_bottom(env.view())
+            .unwrap();
+        within_every_cap(&sc, name, true);
+    }
+}
+
+/// Plans `sc` call after call with caps of 1 to 8 iterations, each
+/// call's iterations within its cap.
+fn within_every_cap(sc: &Scenario<'_, 3>, name: &str, constrained: bool) {
+    for cap in 1..=8 {
+        let mut cfg = PlannerConfig {
+            constrained,
+            ..PlannerConfig::default()
+        };
+        cfg.bfgs.max_iterations = cap;
+        let mut planner = Planner::<5>::new(cfg).unwrap();
+        let mut st = sc.start_state(sc.default_initial_depth());
+        for n in 0..sc.waypoints().tracks() {
+            let Ok(p) = planner.plan(sc, &st, n) else {
+                break;
+            };
+            assert!(
+                p.iterations <= cap,
+                "{name}, cap {cap}, constrained {constrained}, track {}: {} iterations",
+                n + 1,
+                p.iterations
+            );
+            st = p.next_state;
         }
     }
 }

@@ -168,9 +168,20 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if !raised || round == GAP_ROUNDS {
                 break;
             }
+            // Within the call's iteration cap: the re-solve gets what its
+            // start (counted as one) leaves, and none runs where nothing
+            // is left (the raised targets then go to the certificate as
+            // they are).
+            let cap = self.cfg.bfgs.max_iterations;
+            let left = cap.saturating_sub(iterations).saturating_sub(1);
+            if left == 0 {
+                break;
+            }
+            self.cfg.bfgs.max_iterations = left;
             let every = u64::MAX;
-            let (total, _) = self.solve_sqp(obj, &z, (h, bounds), tol, (every, false))?;
-            iterations = total;
+            let solved = self.solve_sqp(obj, &z, (h, bounds), tol, (every, false));
+            self.cfg.bfgs.max_iterations = cap;
+            iterations = solved?.0;
         }
         self.horizon_len = h;
         Ok(iterations)
