@@ -541,6 +541,18 @@ fn the_lift_runs_again_where_the_escapes_moved_the_plan() {
     horizon_within("lift_again", 1.09, 9.006_95e5);
 }
 
+/// The next plateau's held edge (`check_planner.py --seed 2578 --vehicle
+/// tools/reference/vehicles/slow.toml`, `unseen_2578_0`): the cold SQP
+/// ended with tracks 4 and 5 on saturated dives' plateaus, track 5 held
+/// at its target, and track 3 (480.5 m) blocked. The held edge restarted
+/// from the best start only (track 5's), which ended no lower; the line's
+/// `J` was 8.704e6 m³, 2.17× the f64 beam search's best safe plan
+/// (4.008 37e6 m³). From the start off track 4's plateau, 1.0013×.
+#[test]
+fn the_next_plateaus_held_edge_is_tried() {
+    horizon_within("held_next", 1.01, 4.008_37e6);
+}
+
 /// The committed depth polished where the depth loop integrates
 /// (`check_planner.py --seed 2002 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2002_7`): the SQP
