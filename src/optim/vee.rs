@@ -51,25 +51,20 @@ impl Vee {
         dir: &Vector<K>,
         rejected: Option<&(Vector<K>, f32)>,
     ) {
-        let Some(axis) = lone_axis(dir) else {
-            *self = Self::default();
-            return;
-        };
-        let (Some(&zi), Some(&gi), Some(&di)) = (z.get(axis), g.get(axis), dir.get(axis)) else {
+        // One free variable, and `J` still falling towards the rejected
+        // side; else nothing is kept.
+        let along = lone_axis(dir).and_then(|a| Some((a, *z.get(a)?, *g.get(a)?, *dir.get(a)?)));
+        let Some((axis, zi, _, di)) = along.filter(|&(_, _, gi, di)| gi * di < 0.0) else {
             *self = Self::default();
             return;
         };
         let ahead = |p: &(f32, f32)| (p.0 - zi) * di > 0.0 && p.1.is_finite();
         let new = rejected.and_then(|(r, jr)| r.get(axis).map(|&ri| (ri, *jr)));
-        let mut kept = if axis == self.axis {
+        let kept = if axis == self.axis {
             [self.near, self.far, new]
         } else {
             [new, None, None]
         };
-        // Only while `J` still falls towards the rejected side.
-        if gi * di >= 0.0 {
-            kept = [None; 3];
-        }
         let by_distance =
             |p: &Option<(f32, f32)>| p.map_or(f32::INFINITY, |p| libm::fabsf(p.0 - zi));
         let mut points = kept.map(|p| p.filter(ahead));
