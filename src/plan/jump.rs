@@ -290,13 +290,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // points already; this pass is for the held edges.)
             *slot = self.sqp_plateau_jump(obj, bounds, j, (tol, PRICED_OUT, true));
         }
-        // Best first; the next only where no restart from one was kept.
-        starts.sort_unstable_by(|a, b| match (a, b) {
-            (Some(a), Some(b)) if lex_less(a.0, b.0) => core::cmp::Ordering::Less,
-            (Some(a), Some(b)) if lex_less(b.0, a.0) => core::cmp::Ordering::Greater,
-            (Some(_), Some(_)) | (None, None) => core::cmp::Ordering::Equal,
-            (Some(_), None) => core::cmp::Ordering::Less,
-            (None, Some(_)) => core::cmp::Ordering::Greater,
+        // Best first (none last); the next only where no restart from one
+        // was kept.
+        let score = |s: &Option<Jump<K>>| s.map_or((f32::INFINITY, f32::INFINITY), |c| c.0);
+        starts.sort_unstable_by(|a, b| {
+            let (a, b) = (score(a), score(b));
+            lex_less(b, a).cmp(&lex_less(a, b))
         });
         let mut iterations = iterations;
         for (_, z) in starts.iter().flatten() {
