@@ -38,6 +38,28 @@ fn line(name: &str) -> (Profile<4096>, Waypoints<16>) {
     (map, Waypoints::new(&real_waypoints(name)).unwrap())
 }
 
+/// `f` on line `name` (`h_r`, `h_a`, m) under the declared uncertainty
+/// `u`, certified over its lower envelope. (A closure: the scenario
+/// borrows the map and the envelope made here.)
+fn declared<R>(
+    vehicle: &Vehicle<3>,
+    name: &str,
+    (h_r, h_a): (f32, f32),
+    u: Uncertainty,
+    f: impl FnOnce(&Scenario<'_, 3>) -> R,
+) -> R {
+    let (map, wps) = line(name);
+    let env = lower_envelope::<12288>(map.view(), &u, wps.positions()[0]).unwrap();
+    let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
+        .unwrap()
+        .with_uncertainty(u);
+    let sc = Scenario::new(vehicle, &map, &wps, mission)
+        .unwrap()
+        .with_certification_bottom(env.view())
+        .unwrap();
+    f(&sc)
+}
+
 /// Every track the unbudgeted run (`free`) flies safe is safe in `safe`.
 fn assert_as_safe(free: &[bool], safe: &[bool], what: &str) {
     for (t, (&f, &ok)) in free.iter().zip(safe).enumerate() {
@@ -159,34 +181,26 @@ fn from_measured_states_too() {
 #[test]
 fn under_declared_uncertainty_each_world_is_a_flight() {
     let vehicle = Vehicle::c_auv4().unwrap();
-    let name = "us_monterey_canyon_1";
-    let (map, wps) = line(name);
     // Map error and a speed error: 3 worlds over the lower envelope.
     let u = Uncertainty::new(5.0, 0.001, 2.0, 0.05, 0.0, 0.0).unwrap();
-    let env = lower_envelope::<12288>(map.view(), &u, wps.positions()[0]).unwrap();
-    let mission = Mission::new(80.0, 60.0, [0.0, 6000.0])
-        .unwrap()
-        .with_uncertainty(u);
-    let sc = Scenario::new(&vehicle, &map, &wps, mission)
-        .unwrap()
-        .with_certification_bottom(env.view())
-        .unwrap();
-    // The first call re-certifies its anchor: 1 + 2 W = 7 flights at least.
-    let cfg = PlannerConfig {
-        max_evaluations: 6,
-        ..PlannerConfig::default()
-    };
-    let mut p = Planner::<5>::new(cfg).unwrap();
-    let st = sc.start_state(sc.default_initial_depth());
-    assert_eq!(
-        p.plan(&sc, &st, 0),
-        Err(PlanError::BudgetTooSmall { needed: 7 })
-    );
-    let free = fly_line(&sc, u32::MAX, false);
-    for budget in [7, 10, 20, 50] {
-        let run = fly_line(&sc, budget, false);
-        assert_as_safe(&free.safe, &run.safe, &format!("budget {budget}"));
-    }
+    declared(&vehicle, "us_monterey_canyon_1", (80.0, 60.0), u, |sc| {
+        // The first call re-certifies its anchor: 1 + 2 W = 7 flights at least.
+        let cfg = PlannerConfig {
+            max_evaluations: 6,
+            ..PlannerConfig::default()
+        };
+        let mut p = Planner::<5>::new(cfg).unwrap();
+        let st = sc.start_state(sc.default_initial_depth());
+        assert_eq!(
+            p.plan(sc, &st, 0),
+            Err(PlanError::BudgetTooSmall { needed: 7 })
+        );
+        let free = fly_line(sc, u32::MAX, false);
+        for budget in [7, 10, 20, 50] {
+            let run = fly_line(sc, budget, false);
+            assert_as_safe(&free.safe, &run.safe, &format!("budget {budget}"));
+        }
+    });
 }
 
 /// The resumable form: every step within its flights, the line as safe as
@@ -267,7 +281,6 @@ fn no_call_passes_its_iteration_cap() {
 fn no_certified_call_passes_its_iteration_cap() {
     let vehicle = Vehicle::c_auv4().unwrap();
     for (name, h_r, h_a) in LINES {
-        let (map, wps) = line(name);
         // The README's declarations (`deep_declared.toml`,
         // `shallow_declared.toml`).
         let u = if h_r > 10.0 {
@@ -276,15 +289,9 @@ fn no_certified_call_passes_its_iteration_cap() {
             Uncertainty::new(1.0, 0.0011, 0.3, 0.03, 0.5, 0.015)
         }
         .unwrap();
-        let env = lower_envelope::<12288>(map.view(), &u, wps.positions()[0]).unwrap();
-        let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
-            .unwrap()
-            .with_uncertainty(u);
-        let sc = Scenario::new(&vehicle, &map, &wps, mission)
-            .unwrap()
-            .with_certification_bottom(env.view())
-            .unwrap();
-        within_every_cap(&sc, name, true);
+        declared(&vehicle, name, (h_r, h_a), u, |sc| {
+            within_every_cap(sc, name, true);
+        });
     }
 }
 
