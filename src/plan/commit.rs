@@ -28,7 +28,7 @@ use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
 use super::fallback::Flown;
 use super::flights::Flights;
-use super::knife::{nominal, on_edge};
+use super::knife::nominal;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
@@ -95,8 +95,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // the candidate off it: the candidate's way instead.
         if chosen.previous
             && nominal(sc)
-            && on_edge(sc, track, &flown.next)
-            && !on_edge(sc, track, &cand.flown.next)
+            && sc.on_edge(track, &flown.next)
+            && !sc.on_edge(track, &cand.flown.next)
         {
             let how = (guaranteed, false);
             (chosen, flown) = self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
@@ -123,6 +123,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             &flown.next,
             (only_nominal, lazy, &mut flights),
         );
+        if guaranteed {
+            self.branch_off_the_edge(sc, (state, track), &flown, &mut flights);
+        }
         let safe = chosen.cert.all >= cand.h_safe;
         self.line_j += flown.score.j();
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);

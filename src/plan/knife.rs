@@ -30,21 +30,25 @@
 //! 5's `J` differs from the f64 re-simulation's by 2.1e-3. Under declared
 //! uncertainty nothing is moved ([`nominal`]).
 //!
+//! What no move can avoid, the certificates fly both ways: with nothing
+//! declared, a certificate flies the rest of the line from the other
+//! switch's state too wherever a track ends on the edge
+//! (`certify/mod.rs`), and a committed depth that ends on it leaves that
+//! state in the tube as a branch, flown by every later certificate
+//! ([`Planner::branch_off_the_edge`]).
+//!
 //! In horizon mode, constrained, a call may commit the previous call's
 //! continuation instead of its candidate (`commit.rs`): where that
 //! continuation's first depth is on the edge and the candidate is not,
 //! the call takes the candidate's way (certifies it, or searches).
 
-use crate::sim::{Scenario, TrackScore, VehicleState};
+use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, World, offset};
 
 use super::Planner;
 use super::candidate::Candidate;
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::scan::search_box;
-
-/// Least distance, m, of the samples either side of a waypoint from it.
-pub(super) const EDGE: f32 = 2e-3;
 
 /// First probe, m of depth.
 const PROBE: f32 = 5e-3;
@@ -55,23 +59,6 @@ const MOST: f32 = 0.25;
 /// Most relative rise of the track's `J` a move may cost.
 const J_SHARE: f32 = 1e-3;
 
-/// The signed distance, m, from waypoint `end` to the nearer of the two
-/// samples around it in a flight ending at `next` (the first sample at or
-/// past it): positive for the one past it, negative for the one before.
-pub(super) fn offset<const N: usize>(next: &VehicleState<N>, end: f32) -> f32 {
-    let after = next.x.minus(end);
-    let before = next.x_prev.minus(end);
-    if after <= -before { after } else { before }
-}
-
-/// Waypoint `X_{track+1}` when a track follows it (the knife edge is the
-/// next track's), m.
-fn edge_waypoint<const N: usize>(sc: &Scenario<'_, N>, track: usize) -> Option<f32> {
-    let wp = sc.waypoints().positions();
-    let end = wp.get(track.saturating_add(1)).copied()?;
-    (track.saturating_add(2) < wp.len()).then_some(end)
-}
-
 /// Whether the mission declares no uncertainty. Under declared uncertainty
 /// the certificate's worlds fly the plan off the nominal flight by far
 /// more than a knife edge's hair (speed, current, map), and a moved depth
@@ -80,17 +67,6 @@ fn edge_waypoint<const N: usize>(sc: &Scenario<'_, N>, track: usize) -> Option<f
 /// continuation's certificate and searched, 159 flights against 12).
 pub(super) fn nominal<const N: usize>(sc: &Scenario<'_, N>) -> bool {
     *sc.mission().uncertainty() == crate::model::Uncertainty::NONE
-}
-
-/// Whether a flight of track `track` ending at `next` puts a sample
-/// within [`EDGE`] of the waypoint ending it, a track following.
-pub(super) fn on_edge<const N: usize>(
-    sc: &Scenario<'_, N>,
-    track: usize,
-    next: &VehicleState<N>,
-) -> bool {
-    // (NaN is not near.)
-    edge_waypoint(sc, track).is_some_and(|end| libm::fabsf(offset(next, end)) < EDGE)
 }
 
 impl<const K: usize, const N: usize> Planner<K, N> {
@@ -106,10 +82,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         track: usize,
         cand: &mut Candidate<N>,
     ) {
-        let Some(end) = edge_waypoint(sc, track) else {
+        let Some(end) = sc.edge_waypoint(track) else {
             return;
         };
-        if cand.cert.is_some() || !nominal(sc) || !on_edge(sc, track, &cand.flown.next) {
+        if cand.cert.is_some() || !nominal(sc) || !sc.on_edge(track, &cand.flown.next) {
             return;
         }
         let v0 = offset(&cand.flown.next, end);
@@ -133,6 +109,30 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if let Some(first) = self.work.z.first_mut() {
                 *first = f.depth;
             }
+        }
+    }
+
+    /// With nothing declared, where the committed flight ends on its
+    /// waypoint's knife edge, the tube's branch from the other switch's
+    /// state (`Tube::branch`): the committed depth's certificate flew it
+    /// already (`certify/mod.rs`), and every later call's certificates fly
+    /// it too, so that the line stays certified however the vehicle's
+    /// arithmetic switches there. A budgeted call with no flight left for
+    /// it (its fallback at the least budget) does not carry the branch.
+    pub(super) fn branch_off_the_edge(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        (state, track): (&VehicleState<N>, usize),
+        flown: &Flown<N>,
+        flights: &mut u32,
+    ) {
+        let spent = self.budget.limit != u32::MAX && *flights >= self.budget.limit;
+        if spent || !nominal(sc) || !sc.on_edge(track, &flown.next) {
+            return;
+        }
+        *flights = flights.saturating_add(1);
+        if let Ok((_, other)) = sc.switched_other_way(state, track, flown.depth, &flown.next) {
+            self.tube.branch(World::nominal(sc.vehicle()), &other);
         }
     }
 

@@ -203,6 +203,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         track: usize,
     ) -> Result<Plan<N>, PlanError> {
         self.budget = Budget::NONE;
+        self.tube.set_branch_cap(u32::MAX);
         let cand = self.candidate(sc, state, track)?;
         self.commit(sc, state, track, &cand)
     }

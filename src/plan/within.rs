@@ -7,7 +7,7 @@ use crate::sim::{Scenario, SimError, TrackScore, VehicleState};
 
 use super::budget::Budget;
 use super::candidate::Candidate;
-use super::certify::Certificate;
+use super::certify::{Certificate, fly_other_way};
 use super::commit::{certification_bottom, nominal_only};
 use super::fallback::Flown;
 use super::flights::Flights;
@@ -51,6 +51,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             });
         }
         self.budget = b;
+        self.tube.set_branch_cap(b.limit.saturating_sub(b.tail));
         self.warm_from_continuation(track, sc.waypoints().tracks().saturating_sub(track));
         let saved = self.cfg;
         self.fit_scan(b.candidate, s.h);
@@ -119,6 +120,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (true, _, _) => anchor.saturating_add(tail),
             (false, _, _) => certify.saturating_add(tail),
         };
+        // With nothing declared, the candidate's share also leaves the
+        // flight of a knife edge's branch (`commit.rs`); the fallback does
+        // without it (the branch is then not carried).
+        let knife = u32::from(guaranteed && sc.mission().uncertainty().is_none());
+        let tail = tail.saturating_add(knife);
         let after = certify.saturating_add(anchor).saturating_add(tail);
         let b = Budget {
             limit,
@@ -221,10 +227,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // the budget has a flight for each.
             let fresh = self.previous(track, len).is_none();
             let mut held = None;
+            let cap = self.budget.limit.saturating_sub(self.budget.tail);
             if fresh && self.budget.limit.saturating_sub(fl.count) >= 2 {
                 let rule = terrain_rule(sc, track, len);
-                fl.count = fl.count.saturating_add(1);
-                if let Ok((f, c)) = fly_line(sc, state, track, rule.get(..len).unwrap_or(&[]))
+                let d = rule.get(..len).unwrap_or(&[]);
+                if let Ok((f, c)) = fly_line(sc, (state, track), d, (&mut fl.count, cap))
                     && c.all >= h_safe
                 {
                     depths = rule;
@@ -234,8 +241,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             match held {
                 Some(h) => h,
                 None => {
-                    let (f, c) = fly_line(sc, state, track, depths.get(..len).unwrap_or(&[]))?;
-                    fl.count = fl.count.saturating_add(1);
+                    let d = depths.get(..len).unwrap_or(&[]);
+                    let (f, c) = fly_line(sc, (state, track), d, (&mut fl.count, cap))?;
                     (f, Some(c))
                 }
             }
@@ -299,20 +306,25 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
 /// The nominal line flight of `depths` from `state` on `track` (one flight,
 /// over the map): the first track's flight and the certificate it is when
-/// the nominal world over the map is the only one.
+/// the nominal world over the map is the only one. Where a track ends on
+/// its waypoint's knife edge, the rest is flown the other way too
+/// (`certify/mod.rs`) while `count` is below `cap` (one flight more),
+/// else the line is not certified.
 #[inline(never)]
 fn fly_line<const N: usize>(
     sc: &Scenario<'_, N>,
-    state: &VehicleState<N>,
-    track: usize,
+    (state, track): (&VehicleState<N>, usize),
     depths: &[f32],
+    (count, cap): (&mut u32, u32),
 ) -> Result<(Flown<N>, Certificate), PlanError> {
+    *count = count.saturating_add(1);
     let mut st = *state;
     let mut first: Option<Flown<N>> = None;
     let mut all = f32::INFINITY;
     for (j, &z) in depths.iter().enumerate() {
         let mut score = [TrackScore::default()];
-        match sc.fly(&st, track.saturating_add(j), &[z], &mut score) {
+        let t = track.saturating_add(j);
+        match sc.fly(&st, t, &[z], &mut score) {
             Ok(next) => {
                 let s = score[0];
                 all = all.min(s.min_altitude());
@@ -322,6 +334,18 @@ fn fly_line<const N: usize>(
                         score: s,
                         next,
                     });
+                }
+                let rest = depths.get(j.saturating_add(1)..).unwrap_or(&[]);
+                if !rest.is_empty() && sc.on_edge(t, &next) {
+                    let other = if *count < cap {
+                        *count = count.saturating_add(1);
+                        let (own, later) =
+                            fly_other_way(sc, (&st, t), (z, &next), rest, (0.0, &mut []));
+                        own.min(later)
+                    } else {
+                        f32::NEG_INFINITY
+                    };
+                    all = all.min(other);
                 }
                 st = next;
             }

@@ -13,6 +13,7 @@
 //! | `column.rs` | one tangent column: its step, its sleep where the step is the identity, the pieces it scores |
 //! | `watch.rs` | what a tangent pass records for the SQP: segments' least altitudes, Gauss–Newton |
 //! | `estimate.rs` | [`Measurement`]; the start state from what the vehicle measures |
+//! | `switch.rs` | a track flown with its waypoint switch one sample the other way |
 //! | `world.rs` | [`World`]: true speed, flight-path offset, vertical current |
 //! | `error.rs` | [`SimError`] |
 //! | `rng.rs` | (tests only) the randomized tests' generator |
@@ -27,6 +28,7 @@ mod rng;
 mod run;
 mod score;
 mod state;
+mod switch;
 mod tangent;
 mod watch;
 mod world;
@@ -35,6 +37,7 @@ pub use error::SimError;
 pub use estimate::Measurement;
 pub use score::TrackScore;
 pub use state::{Sample, VehicleState};
+pub(crate) use switch::{EDGE, offset};
 pub use tangent::Evaluation;
 pub(crate) use watch::Watch;
 pub use world::{MAX_WORLDS, World};

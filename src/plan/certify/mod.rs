@@ -84,6 +84,14 @@ pub(super) struct Tube<const N: usize> {
     /// The vehicle margin subtracted from every certified altitude, m.
     margin: f32,
     states: [VehicleState<N>; MAX_WORLDS],
+    /// How many of the last worlds are branches: the nominal world again,
+    /// from the state a committed flight on a knife edge reaches with its
+    /// switch the other way ([`Tube::branch`]).
+    branches: usize,
+    /// A call's flights (as counted into a certificate's `flights`) below
+    /// which a knife edge's branch may still be flown, its certificate's
+    /// other worlds left room ([`Tube::set_branch_cap`]).
+    branch_cap: u32,
     /// The world whose flight set the last certificate's least altitude:
     /// flown first, so that an uncertifiable line is found in one flight.
     worst: Cell<usize>,
@@ -114,6 +122,8 @@ impl<const N: usize> Default for Tube<N> {
             worlds: Vec::new(),
             margin: 0.0,
             states: [VehicleState::trimmed(0.0, 0.0); MAX_WORLDS],
+            branches: 0,
+            branch_cap: u32::MAX,
             worst: Cell::new(0),
             critical: Cell::new([0; 3]),
             track: 0,
@@ -172,6 +182,15 @@ impl<const N: usize> Tube<N> {
     /// complete one.
     pub fn minima_of(&self, c: &Certificate) -> Option<[f32; MAX_TRACKS]> {
         (c.id != 0 && c.id == self.minima_of.get() && !c.partial).then(|| self.minima.get())
+    }
+
+    /// Sets the flight count (of the call, as certificates count it) that
+    /// a knife edge's branch may not reach, its certificate's other
+    /// worlds left room: a budgeted call's limit less what its commit
+    /// needs after the certificate (`u32::MAX`: no budget). Where a branch
+    /// is not affordable, the tracks after its edge are not certified.
+    pub fn set_branch_cap(&mut self, cap: u32) {
+        self.branch_cap = cap;
     }
 
     /// Forgets the worlds' states.
@@ -234,7 +253,10 @@ impl<const N: usize> Tube<N> {
             };
             let at = (st, self.at());
             let minima = (self.margin, &mut per_track[..]);
-            let (first, all) = fly_world(sc, w, bottom, at, depths, minima, flights);
+            // (Room for every world's flight after a branch.)
+            let worlds = u32::try_from(self.worlds.len()).unwrap_or(u32::MAX);
+            let cap = self.branch_cap.saturating_sub(worlds);
+            let (first, all) = fly_world(sc, w, bottom, at, depths, minima, (flights, cap));
             flown = flown.saturating_add(1);
             c.first = c.first.min(first - self.margin);
             if all - self.margin < c.all {
@@ -332,6 +354,16 @@ impl<const N: usize> Tube<N> {
 /// on the first track, and to the end (`-inf` from the track on which a
 /// flight fails). Each track's altitude less `margin` also lowers the
 /// matching entry of `per_track` (which may be shorter, or empty).
+///
+/// With nothing declared (the nominal world alone), where a track's end
+/// lies on its waypoint's knife edge ([`Scenario::on_edge`]), the rest is
+/// also flown from the other switch's state
+/// ([`Scenario::switched_other_way`]) while `flights` is below `cap`
+/// (else the later tracks are not certified), and both flights count: the same
+/// depths flown in other arithmetic may switch the other way, and the
+/// next track's least altitude can move by a tenth of a metre
+/// (`check_planner.py --seed 2585`, `unseen_2585_5`: 60.09 m in f32,
+/// 59.974 m in f64, below `h_a`).
 /// (Not inlined: its callers share one copy of the flight.)
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
@@ -342,27 +374,45 @@ fn fly_world<const N: usize>(
     (st, track): (&VehicleState<N>, usize),
     depths: &[f32],
     (margin, per_track): (f32, &mut [f32]),
-    flights: &mut u32,
+    (flights, cap): (&mut u32, u32),
 ) -> (f32, f32) {
     let Ok(scw) = sc.in_world(w, bottom) else {
         return (f32::NEG_INFINITY, f32::NEG_INFINITY);
     };
+    let branches = sc.mission().uncertainty().is_none();
     let mut score = [TrackScore::default()];
     let mut state = *st;
     let (mut first, mut all) = (f32::INFINITY, f32::INFINITY);
     // One flight of the line, flown track by track (runs chain exactly).
     *flights = flights.saturating_add(1);
     for (j, &z) in depths.iter().enumerate() {
-        let flown = scw.fly(&state, track.saturating_add(j), &[z], &mut score);
-        let h = match flown {
-            Ok(next) => {
-                state = next;
-                score
-                    .first()
-                    .map_or(f32::NEG_INFINITY, TrackScore::min_altitude)
-            }
+        let t = track.saturating_add(j);
+        let flown = scw.fly(&state, t, &[z], &mut score);
+        let mut h = match flown {
+            Ok(_) => score
+                .first()
+                .map_or(f32::NEG_INFINITY, TrackScore::min_altitude),
             Err(_) => f32::NEG_INFINITY,
         };
+        let rest = depths.get(j.saturating_add(1)..).unwrap_or(&[]);
+        if let Ok(next) = flown
+            && branches
+            && !rest.is_empty()
+            && scw.on_edge(t, &next)
+        {
+            let mine = per_track.get_mut(j.saturating_add(1)..).unwrap_or(&mut []);
+            let (own, later) = if *flights < cap {
+                *flights = flights.saturating_add(1);
+                fly_other_way(&scw, (&state, t), (z, &next), rest, (margin, mine))
+            } else {
+                // (No flight left for the branch: the later tracks are
+                // not certified.)
+                mine.iter_mut().for_each(|l| *l = f32::NEG_INFINITY);
+                (h, f32::NEG_INFINITY)
+            };
+            h = h.min(own);
+            all = all.min(later);
+        }
         all = all.min(h);
         if j == 0 {
             first = h;
@@ -370,11 +420,50 @@ fn fly_world<const N: usize>(
         if let Some(l) = per_track.get_mut(j) {
             *l = l.min(h - margin);
         }
-        if flown.is_err() {
-            break;
+        match flown {
+            Ok(next) => state = next,
+            Err(_) => break,
         }
     }
     (first, all)
+}
+
+/// The flight of track `track` at `z` from `st`, its end `next` on a knife
+/// edge, with the switch the other way, then `rest` (one depth per later
+/// track) from there: the least altitude on its own track, and on the
+/// later ones (`-inf` from a flight that fails), each later track's less
+/// `margin` also lowering `per_track` (from the track after `track`).
+/// The other way's own later edges are not branched again.
+#[inline(never)]
+pub(super) fn fly_other_way<const N: usize>(
+    scw: &Scenario<'_, N>,
+    (st, track): (&VehicleState<N>, usize),
+    (z, next): (f32, &VehicleState<N>),
+    rest: &[f32],
+    (margin, per_track): (f32, &mut [f32]),
+) -> (f32, f32) {
+    let Ok((own, mut state)) = scw.switched_other_way(st, track, z, next) else {
+        return (f32::NEG_INFINITY, f32::NEG_INFINITY);
+    };
+    let mut score = [TrackScore::default()];
+    let mut later = f32::INFINITY;
+    for (i, &zi) in rest.iter().enumerate() {
+        let t = track.saturating_add(1).saturating_add(i);
+        let flown = scw.fly(&state, t, &[zi], &mut score);
+        let h = match (&flown, score.first()) {
+            (Ok(_), Some(s)) => s.min_altitude(),
+            _ => f32::NEG_INFINITY,
+        };
+        later = later.min(h);
+        if let Some(l) = per_track.get_mut(i) {
+            *l = l.min(h - margin);
+        }
+        match flown {
+            Ok(n) => state = n,
+            Err(_) => break,
+        }
+    }
+    (own.min_altitude(), later)
 }
 
 /// Certifies a fixed line (model contract §12): `depths` (one per track
@@ -410,7 +499,7 @@ pub fn certify_line<const N: usize>(
             at,
             depths,
             (margin, &mut *least),
-            &mut flights,
+            (&mut flights, u32::MAX),
         );
     }
     Ok(())

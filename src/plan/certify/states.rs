@@ -44,10 +44,13 @@ impl<const N: usize> Tube<N> {
         track: usize,
     ) -> bool {
         self.margin = margin;
-        let kept =
-            self.at() == track && self.nominal.as_ref() == Some(state) && self.worlds == worlds;
+        let declared = self.worlds.len().saturating_sub(self.branches);
+        let kept = self.at() == track
+            && self.nominal.as_ref() == Some(state)
+            && self.worlds.get(..declared) == Some(&worlds[..]);
         if !kept {
             self.worlds = worlds;
+            self.branches = 0;
             self.states.fill(*state);
             self.critical.set([0; 3]);
             self.pending.clear();
@@ -98,6 +101,7 @@ impl<const N: usize> Tube<N> {
             }
         }
         if failed {
+            self.forget_branches();
             self.states.fill(*state);
             self.critical.set([0; 3]);
             self.track = track;
@@ -115,6 +119,33 @@ impl<const N: usize> Tube<N> {
             self.pending.clear();
             self.done = [0; MAX_WORLDS];
         }
+    }
+
+    /// Adds a branch ([`Tube::branches`]): `world` (the nominal one) again,
+    /// from `state`, where the last committed depth's nominal flight
+    /// reached the track the tube is at with its switch the other way
+    /// ([`Scenario::switched_other_way`]). None is added where the worlds
+    /// are full or the tube holds no states.
+    pub fn branch(&mut self, world: World, state: &VehicleState<N>) {
+        let i = self.worlds.len();
+        if self.nominal.is_none() || self.worlds.push(world).is_err() {
+            return;
+        }
+        if let (Some(st), Some(done)) = (self.states.get_mut(i), self.done.get_mut(i)) {
+            *st = *state;
+            // (At the call's track already: past every pending depth.)
+            *done = u8::try_from(self.pending.len()).unwrap_or(u8::MAX);
+            self.branches = self.branches.saturating_add(1);
+        } else {
+            self.worlds.truncate(i);
+        }
+    }
+
+    /// Drops the branch worlds.
+    fn forget_branches(&mut self) {
+        let declared = self.worlds.len().saturating_sub(self.branches);
+        self.worlds.truncate(declared);
+        self.branches = 0;
     }
 
     /// Whether some worlds have pending depths left to fly.
@@ -262,5 +293,48 @@ mod tests {
             (f32::NEG_INFINITY, &mut flights),
         );
         assert_eq!(last.all.to_bits(), minima[2].to_bits());
+    }
+
+    /// A branch world is kept with the tube and flown by its certificates
+    /// (its own state's flight counts), and dropped when the tube starts
+    /// again.
+    #[test]
+    fn a_branch_is_kept_and_flown_until_the_tube_restarts() {
+        let v = Vehicle::c_auv4().unwrap();
+        let p =
+            Profile::<8>::new(&[0.0, 400.0, 700.0, 2200.0], &[300.0, 300.0, 180.0, 200.0]).unwrap();
+        let w = Waypoints::<4>::new(&[0.0, 600.0, 1400.0, 2100.0]).unwrap();
+        let sc = Scenario::new(&v, &p, &w, Mission::default()).unwrap();
+        let u = Uncertainty::NONE;
+        let start = sc.start_state(220.0);
+        let worlds = || (World::corners(&v, &u), vehicle_margin(&v, &u));
+        let mut tube = Tube::default();
+        tube.prepare(worlds(), &start, 0);
+        let mut s = [TrackScore::default()];
+        let next = sc.fly(&start, 0, &[230.0], &mut s).unwrap();
+        let (_, other) = sc.switched_other_way(&start, 0, 230.0, &next).unwrap();
+        let mut flights = 0;
+        tube.advance((&sc, p.view()), 230.0, &next, (true, true, &mut flights));
+        tube.branch(World::nominal(&v), &other);
+        assert_eq!(tube.count(), 2);
+        assert!(!tube.nominal_only(&World::nominal(&v), &next));
+        assert!(tube.prepare(worlds(), &next, 1));
+        assert_eq!(tube.count(), 2);
+        // Each world flies from its own state: the branch's altitudes
+        // bound the certificate.
+        let depths = [110.0, 120.0];
+        let mut few = 0;
+        let c = tube.certify(&sc, p.view(), &depths, (f32::NEG_INFINITY, &mut few));
+        assert!(few >= 2 && !c.partial);
+        let mut one = [TrackScore::default(); 2];
+        sc.fly(&other, 1, &depths, &mut one).unwrap();
+        let branch_least = one
+            .iter()
+            .map(TrackScore::min_altitude)
+            .fold(f32::INFINITY, f32::min);
+        assert!(c.all <= branch_least);
+        // Another start: the tube restarts without it.
+        assert!(!tube.prepare(worlds(), &other, 1));
+        assert_eq!(tube.count(), 1);
     }
 }
