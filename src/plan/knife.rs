@@ -117,8 +117,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// state (`Tube::branch`): the committed depth's certificate flew it
     /// already (`certify/mod.rs`), and every later call's certificates fly
     /// it too, so that the line stays certified however the vehicle's
-    /// arithmetic switches there. A budgeted call with no flight left for
-    /// it (its fallback at the least budget) does not carry the branch.
+    /// arithmetic switches there. A budgeted call carries no branch: every
+    /// later call would fly it, and its least budget would be a flight
+    /// more (a budgeted call's certificates still fly an edge's other
+    /// switch when their flights allow, `certify/mod.rs`).
     pub(super) fn branch_off_the_edge(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -126,8 +128,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         flown: &Flown<N>,
         flights: &mut u32,
     ) {
-        let spent = self.budget.limit != u32::MAX && *flights >= self.budget.limit;
-        if spent || !nominal(sc) || !sc.on_edge(track, &flown.next) {
+        let budgeted = self.budget.limit != u32::MAX;
+        if budgeted || !nominal(sc) || !sc.on_edge(track, &flown.next) {
             return;
         }
         *flights = flights.saturating_add(1);

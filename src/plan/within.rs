@@ -120,11 +120,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (true, _, _) => anchor.saturating_add(tail),
             (false, _, _) => certify.saturating_add(tail),
         };
-        // With nothing declared, the candidate's share also leaves the
-        // flight of a knife edge's branch (`commit.rs`); the fallback does
-        // without it (the branch is then not carried).
-        let knife = u32::from(guaranteed && sc.mission().uncertainty().is_none());
-        let tail = tail.saturating_add(knife);
         let after = certify.saturating_add(anchor).saturating_add(tail);
         let b = Budget {
             limit,
@@ -308,8 +303,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 /// over the map): the first track's flight and the certificate it is when
 /// the nominal world over the map is the only one. Where a track ends on
 /// its waypoint's knife edge, the rest is flown the other way too
-/// (`certify/mod.rs`) while `count` is below `cap` (one flight more),
-/// else the line is not certified.
+/// (`certify/mod.rs`) while `count` is below `cap` (one flight more;
+/// else the nominal switch alone, the contract's certificate).
 #[inline(never)]
 fn fly_line<const N: usize>(
     sc: &Scenario<'_, N>,
@@ -336,16 +331,12 @@ fn fly_line<const N: usize>(
                     });
                 }
                 let rest = depths.get(j.saturating_add(1)..).unwrap_or(&[]);
-                if !rest.is_empty() && sc.on_edge(t, &next) {
-                    let other = if *count < cap {
-                        *count = count.saturating_add(1);
-                        let (own, later) =
-                            fly_other_way(sc, (&st, t), (z, &next), rest, (0.0, &mut []));
-                        own.min(later)
-                    } else {
-                        f32::NEG_INFINITY
-                    };
-                    all = all.min(other);
+                // (No flight left: the nominal switch alone, §11's.)
+                if !rest.is_empty() && sc.on_edge(t, &next) && *count < cap {
+                    *count = count.saturating_add(1);
+                    let (own, later) =
+                        fly_other_way(sc, (&st, t), (z, &next), rest, (0.0, &mut []));
+                    all = all.min(own.min(later));
                 }
                 st = next;
             }

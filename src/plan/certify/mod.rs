@@ -188,7 +188,8 @@ impl<const N: usize> Tube<N> {
     /// a knife edge's branch may not reach, its certificate's other
     /// worlds left room: a budgeted call's limit less what its commit
     /// needs after the certificate (`u32::MAX`: no budget). Where a branch
-    /// is not affordable, the tracks after its edge are not certified.
+    /// is not affordable, the certificate is the nominal switch's alone
+    /// (model contract §11's).
     pub fn set_branch_cap(&mut self, cap: u32) {
         self.branch_cap = cap;
     }
@@ -359,7 +360,7 @@ impl<const N: usize> Tube<N> {
 /// lies on its waypoint's knife edge ([`Scenario::on_edge`]), the rest is
 /// also flown from the other switch's state
 /// ([`Scenario::switched_other_way`]) while `flights` is below `cap`
-/// (else the later tracks are not certified), and both flights count: the same
+/// (else the nominal switch alone), and both flights count: the same
 /// depths flown in other arithmetic may switch the other way, and the
 /// next track's least altitude can move by a tenth of a metre
 /// (`check_planner.py --seed 2585`, `unseen_2585_5`: 60.09 m in f32,
@@ -401,14 +402,13 @@ fn fly_world<const N: usize>(
             && scw.on_edge(t, &next)
         {
             let mine = per_track.get_mut(j.saturating_add(1)..).unwrap_or(&mut []);
+            // (No flight left for the branch: the nominal switch alone,
+            // the contract's certificate.)
             let (own, later) = if *flights < cap {
                 *flights = flights.saturating_add(1);
                 fly_other_way(&scw, (&state, t), (z, &next), rest, (margin, mine))
             } else {
-                // (No flight left for the branch: the later tracks are
-                // not certified.)
-                mine.iter_mut().for_each(|l| *l = f32::NEG_INFINITY);
-                (h, f32::NEG_INFINITY)
+                (h, f32::INFINITY)
             };
             h = h.min(own);
             all = all.min(later);
