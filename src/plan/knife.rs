@@ -121,6 +121,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// later call would fly it, and its least budget would be a flight
     /// more (a budgeted call's certificates still fly an edge's other
     /// switch when their flights allow, `certify/mod.rs`).
+    #[inline(never)]
     pub(super) fn branch_off_the_edge(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -133,7 +134,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return;
         }
         *flights = flights.saturating_add(1);
-        if let Ok((_, other)) = sc.switched_other_way(state, track, flown.depth, &flown.next) {
+        let (mut from, mut other) = (*state, flown.next);
+        let mut score = [TrackScore::default()];
+        let at = (track, flown.depth);
+        if sc
+            .switch_other_way((&mut from, &mut other), at, &mut score)
+            .is_ok()
+        {
             self.tube.branch(World::nominal(sc.vehicle()), &other);
         }
     }

@@ -3,11 +3,11 @@
 //! candidate within its share, the fallback (see `budget.rs`).
 
 use crate::model::ProfileView;
-use crate::sim::{Scenario, SimError, TrackScore, VehicleState};
+use crate::sim::{Scenario, SimError, TrackScore, VehicleState, World};
 
 use super::budget::Budget;
 use super::candidate::Candidate;
-use super::certify::{Certificate, fly_other_way};
+use super::certify::{Certificate, fly_once};
 use super::commit::{certification_bottom, nominal_only};
 use super::fallback::Flown;
 use super::flights::Flights;
@@ -330,13 +330,14 @@ fn fly_line<const N: usize>(
                         next,
                     });
                 }
-                let rest = depths.get(j.saturating_add(1)..).unwrap_or(&[]);
-                // (No flight left: the nominal switch alone, §11's.)
-                if !rest.is_empty() && sc.on_edge(t, &next) && *count < cap {
+                // (This track and the later ones; no flight left: the
+                // nominal switch alone, §11's.)
+                let from = depths.get(j..).unwrap_or(&[]);
+                if from.len() > 1 && sc.on_edge(t, &next) && *count < cap {
                     *count = count.saturating_add(1);
-                    let (own, later) =
-                        fly_other_way(sc, (&st, t), (z, &next), rest, (0.0, &mut []));
-                    all = all.min(own.min(later));
+                    let nominal = (&World::nominal(sc.vehicle()), sc.profile());
+                    let other = fly_once(sc, nominal, (&st, t), from, (0.0, &mut []), Some(0));
+                    all = all.min(other.map_or(f32::NEG_INFINITY, |(_, a, _)| a));
                 }
                 st = next;
             }

@@ -109,7 +109,7 @@ impl<const N: usize> Scenario<'_, N> {
     ///
     /// # Errors
     /// As [`Scenario::simulate`].
-    #[inline(never)]
+    #[inline(always)]
     pub(crate) fn fly(
         &self,
         start: &VehicleState<N>,
@@ -117,7 +117,26 @@ impl<const N: usize> Scenario<'_, N> {
         depths: &[f32],
         scores: &mut [TrackScore],
     ) -> Result<VehicleState<N>, SimError> {
-        self.simulate(start, first_track, depths, scores, |_| {})
+        self.fly_to(start, (first_track, depths), scores, None)
+    }
+
+    /// [`Scenario::fly`], the run ending at the first sample at or past
+    /// `stop` (m) instead of the last track's waypoint where it is given
+    /// (`switch.rs`: a switch one sample the other way): the one
+    /// out-of-line copy of the loop with no observer.
+    ///
+    /// # Errors
+    /// As [`Scenario::simulate`].
+    #[inline(never)]
+    pub(crate) fn fly_to(
+        &self,
+        start: &VehicleState<N>,
+        (first_track, depths): (usize, &[f32]),
+        scores: &mut [TrackScore],
+        stop: Option<f32>,
+    ) -> Result<VehicleState<N>, SimError> {
+        let none = &mut NoSensitivity;
+        self.run_to::<_, _, true>(start, (first_track, depths), scores, (none, |_| {}), stop)
     }
 
     /// The one simulation loop; see the module docs. `FAST` selects the
@@ -131,10 +150,24 @@ impl<const N: usize> Scenario<'_, N> {
         depths: &[f32],
         scores: &mut [TrackScore],
         sens: &mut Sn,
-        mut observe: F,
+        observe: F,
+    ) -> Result<VehicleState<N>, SimError> {
+        self.run_to::<_, _, FAST>(start, (first, depths), scores, (sens, observe), None)
+    }
+
+    /// [`Scenario::run`], ending at the first sample at or past `stop` (m)
+    /// where it is given.
+    #[inline(always)]
+    fn run_to<Sn: Sensitivity<N>, F: FnMut(&Sample), const FAST: bool>(
+        &self,
+        start: &VehicleState<N>,
+        (first, depths): (usize, &[f32]),
+        scores: &mut [TrackScore],
+        (sens, mut observe): (&mut Sn, F),
+        stop: Option<f32>,
     ) -> Result<VehicleState<N>, SimError> {
         let (last, scores) = self.prepare(start, first, depths, scores)?;
-        let mut fl = self.begin(start, first, last, scores, sens)?;
+        let mut fl = self.begin(start, (first, last), scores, sens, stop)?;
         loop {
             // A sample whose step needs the general treatment: the end of
             // the run, a waypoint switch, a new bottom segment, a sample
@@ -216,17 +249,24 @@ impl<const N: usize> Scenario<'_, N> {
     fn begin<Sn: Sensitivity<N>>(
         &self,
         start: &VehicleState<N>,
-        first: usize,
-        last: usize,
+        (first, last): (usize, usize),
         scores: &mut [TrackScore],
         sens: &mut Sn,
+        stop: Option<f32>,
     ) -> Result<Flight<N>, SimError> {
         let wp = self.waypoints.positions();
         let x_begin = *wp.get(first).ok_or(SimError::TrackRange)?;
-        let x_end = *wp.get(last).ok_or(SimError::TrackRange)?;
-        let track_end = *wp
+        let mut x_end = *wp.get(last).ok_or(SimError::TrackRange)?;
+        let mut track_end = *wp
             .get(first.saturating_add(1))
             .ok_or(SimError::TrackRange)?;
+        if let Some(stop) = stop {
+            // (One track: where it ends is where the run does.)
+            x_end = stop;
+            if last == first.saturating_add(1) {
+                track_end = stop;
+            }
+        }
         let plant = self.vehicle.plant();
         // Even flying at 75° on average the line would be done by then.
         let max_steps = 4.0 * (x_end - start.x()) / self.kin.step + 100.0;

@@ -6,7 +6,7 @@
 //! implementation, or the vehicle's own) can switch one sample earlier or
 //! later, and the next track's flight differs by far more than the
 //! rounding. [`Scenario::on_edge`] says when a flight's end is that
-//! close ([`EDGE`]); [`Scenario::switched_other_way`] gives the state the
+//! close ([`EDGE`]); [`Scenario::switch_other_way`] gives the state the
 //! other switch starts the next track from, so that a planner can fly
 //! both.
 //!
@@ -14,7 +14,6 @@
 //! same depths put the sample nearest a waypoint 0.05 mm apart at the
 //! median and 0.8 mm at most (`plan/knife.rs`).
 
-use crate::model::Waypoints;
 use crate::num::Comp;
 
 use super::{Scenario, SimError, TrackScore, VehicleState};
@@ -54,49 +53,45 @@ impl<const N: usize> Scenario<'_, N> {
     /// whose own end is `next` (the first sample at or past waypoint
     /// `X_{track+1}`), with its switch one sample the other way from the
     /// sample nearer the waypoint: one sample later where `next` is the
-    /// nearer, one sample earlier where the sample before it is. Returns
-    /// that flight's score and end state; a state one sample early lies
-    /// short of the waypoint by less than the nearer sample's distance
-    /// and is put at `X_{track+1}` (a move of that distance along track,
-    /// so that the next track can start from it).
+    /// nearer, one sample earlier where the sample before it is. Its end
+    /// state replaces `next`; a state one sample early lies short of the
+    /// waypoint by less than the nearer sample's distance and is put at
+    /// `X_{track+1}` (a move of that distance along track, so that the
+    /// next track can start from it), its previous sample where it was.
+    /// `start` is used up (moved along track) and `score` scored anew.
+    /// (In place: a certificate's flight holds no more states for it.)
     ///
     /// # Errors
-    /// [`SimError`] for a track past the line, a flight that fails, or
-    /// an end that is not a step past `start`.
-    pub(crate) fn switched_other_way(
+    /// [`SimError`] for a track past the line or a flight that fails.
+    #[inline(always)]
+    pub(crate) fn switch_other_way(
         &self,
-        start: &VehicleState<N>,
-        track: usize,
-        depth: f32,
-        next: &VehicleState<N>,
-    ) -> Result<(TrackScore, VehicleState<N>), SimError> {
+        (start, next): (&mut VehicleState<N>, &mut VehicleState<N>),
+        (track, depth): (usize, f32),
+        score: &mut [TrackScore; 1],
+    ) -> Result<(), SimError> {
         let wp = self.waypoints.positions();
-        let a = *wp.get(track).ok_or(SimError::TrackRange)?;
         let end = *wp
             .get(track.saturating_add(1))
             .ok_or(SimError::TrackRange)?;
         let (after, before) = (next.x.minus(end), next.x_prev.minus(end));
-        let step = next.x.diff(next.x_prev);
-        let later = after <= -before;
-        // Half a step past `next`, or half a step short of the sample
-        // before it: the run then ends one sample later, or earlier.
-        let stop = if later {
-            next.x.value() + 0.5 * step
-        } else {
-            next.x_prev.value() - 0.5 * step
-        };
-        let line = Waypoints::<2>::new(&[a, stop]).map_err(|_| SimError::TrackRange)?;
-        let sc = Scenario {
-            waypoints: line.view(),
-            ..*self
-        };
-        let mut score = [TrackScore::default()];
-        let mut st = sc.fly(start, 0, &[depth], &mut score)?;
-        if !later {
-            st.x = Comp::new(end);
+        if after <= -before {
+            // One sample later: the run ends half a step past `next`.
+            let stop = next.x.value() + 0.5 * next.x.diff(next.x_prev);
+            *next = self.fly_to(start, (track, &[depth]), score, Some(stop))?;
+            return Ok(());
         }
-        let [s] = score;
-        Ok((s, st))
+        // One sample earlier: the flight moved on along track by what the
+        // sample before `next` lacks of the waypoint (and a hair), which
+        // moves no state but the position (the loop's dynamics do not
+        // depend on it), so that sample is the first past the waypoint.
+        let shift = -before + EDGE * 1e-3;
+        start.x = start.x.add(shift);
+        start.x_prev = start.x_prev.add(shift);
+        *next = self.fly_to(start, (track, &[depth]), score, None)?;
+        next.x = Comp::new(end);
+        next.x_prev = next.x_prev.add(-shift);
+        Ok(())
     }
 }
 
@@ -121,7 +116,10 @@ mod tests {
             let z = 200.0 + 0.37 * k as f32;
             let mut s = [TrackScore::default()];
             let next = sc.fly(&start, 0, &[z], &mut s).unwrap();
-            let (_, other) = sc.switched_other_way(&start, 0, z, &next).unwrap();
+            let mut other = next;
+            let mut from = start;
+            sc.switch_other_way((&mut from, &mut other), (0, z), &mut s)
+                .unwrap();
             let step = next.x.diff(next.x_prev);
             if offset(&next, 600.0) >= 0.0 {
                 seen[0] = true;

@@ -357,62 +357,86 @@ impl<const N: usize> Tube<N> {
 /// matching entry of `per_track` (which may be shorter, or empty).
 ///
 /// With nothing declared (the nominal world alone), where a track's end
-/// lies on its waypoint's knife edge ([`Scenario::on_edge`]), the rest is
-/// also flown from the other switch's state
-/// ([`Scenario::switched_other_way`]) while `flights` is below `cap`
-/// (else the nominal switch alone), and both flights count: the same
-/// depths flown in other arithmetic may switch the other way, and the
-/// next track's least altitude can move by a tenth of a metre
-/// (`check_planner.py --seed 2585`, `unseen_2585_5`: 60.09 m in f32,
-/// 59.974 m in f64, below `h_a`).
-/// (Not inlined: its callers share one copy of the flight.)
+/// lies on its waypoint's knife edge ([`Scenario::on_edge`]), the line is
+/// also flown with that switch the other way ([`fly_once`]'s branch, one
+/// flight more each) while `flights` is below `cap` (else the nominal
+/// switch alone), and both flights count: the same depths flown in other
+/// arithmetic may switch the other way, and the next track's least
+/// altitude can move by a tenth of a metre (`check_planner.py --seed
+/// 2585`, `unseen_2585_5`: 60.09 m in f32, 59.974 m in f64, below `h_a`).
+/// (Not inlined: its callers share one copy of the flight. A branch flies
+/// from the world's start again, after the first flight rather than
+/// inside it, so that a certificate's stack holds one flight at a time.)
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
 fn fly_world<const N: usize>(
     sc: &Scenario<'_, N>,
     w: &World,
     bottom: ProfileView<'_>,
-    (st, track): (&VehicleState<N>, usize),
+    at: (&VehicleState<N>, usize),
     depths: &[f32],
     (margin, per_track): (f32, &mut [f32]),
     (flights, cap): (&mut u32, u32),
 ) -> (f32, f32) {
-    let Ok(scw) = sc.in_world(w, bottom) else {
-        return (f32::NEG_INFINITY, f32::NEG_INFINITY);
+    const FAILED: (f32, f32) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
+    let world = (w, bottom);
+    *flights = flights.saturating_add(1);
+    let Ok((first, mut all, edges)) =
+        fly_once(sc, world, at, depths, (margin, &mut *per_track), None)
+    else {
+        return FAILED;
     };
-    let branches = sc.mission().uncertainty().is_none();
+    let edges = if sc.mission().uncertainty().is_none() {
+        edges
+    } else {
+        0
+    };
+    for j in (0..depths.len().min(64)).filter(|&j| (edges >> j) & 1 == 1) {
+        if *flights >= cap {
+            break;
+        }
+        *flights = flights.saturating_add(1);
+        let minima = (margin, &mut *per_track);
+        all = match fly_once(sc, world, at, depths, minima, Some(j)) {
+            Ok((_, a, _)) => all.min(a),
+            Err(_) => f32::NEG_INFINITY,
+        };
+    }
+    (first, all)
+}
+
+/// One flight of the line `depths` from `st` on `track` in world `w` over
+/// `bottom`: the least altitude on the first track, and to the end
+/// (`-inf` from the track on which a flight fails), each track's less
+/// `margin` also lowering its entry of `per_track`; with the tracks whose
+/// end lies on a knife edge, a track of `depths` following (bit `j` for
+/// track `track + j`, the first 64). With `branch` `Some(j)`, the switch
+/// at the end of track `j` (of `depths`) falls the other way
+/// ([`Scenario::switch_other_way`]; its own edges are not reported).
+///
+/// # Errors
+/// [`SimError`] for a waypoint outside `bottom`.
+#[inline(always)]
+pub(super) fn fly_once<const N: usize>(
+    sc: &Scenario<'_, N>,
+    (w, bottom): (&World, ProfileView<'_>),
+    (st, track): (&VehicleState<N>, usize),
+    depths: &[f32],
+    (margin, per_track): (f32, &mut [f32]),
+    branch: Option<usize>,
+) -> Result<(f32, f32, u64), SimError> {
+    let scw = sc.in_world(w, bottom)?;
     let mut score = [TrackScore::default()];
     let mut state = *st;
-    let (mut first, mut all) = (f32::INFINITY, f32::INFINITY);
+    let (mut first, mut all, mut edges) = (f32::INFINITY, f32::INFINITY, 0_u64);
     // One flight of the line, flown track by track (runs chain exactly).
-    *flights = flights.saturating_add(1);
     for (j, &z) in depths.iter().enumerate() {
         let t = track.saturating_add(j);
         let flown = scw.fly(&state, t, &[z], &mut score);
-        let mut h = match flown {
-            Ok(_) => score
-                .first()
-                .map_or(f32::NEG_INFINITY, TrackScore::min_altitude),
-            Err(_) => f32::NEG_INFINITY,
+        let h = match (&flown, score.first()) {
+            (Ok(_), Some(s)) => s.min_altitude(),
+            _ => f32::NEG_INFINITY,
         };
-        let rest = depths.get(j.saturating_add(1)..).unwrap_or(&[]);
-        if let Ok(next) = flown
-            && branches
-            && !rest.is_empty()
-            && scw.on_edge(t, &next)
-        {
-            let mine = per_track.get_mut(j.saturating_add(1)..).unwrap_or(&mut []);
-            // (No flight left for the branch: the nominal switch alone,
-            // the contract's certificate.)
-            let (own, later) = if *flights < cap {
-                *flights = flights.saturating_add(1);
-                fly_other_way(&scw, (&state, t), (z, &next), rest, (margin, mine))
-            } else {
-                (h, f32::INFINITY)
-            };
-            h = h.min(own);
-            all = all.min(later);
-        }
         all = all.min(h);
         if j == 0 {
             first = h;
@@ -420,50 +444,30 @@ fn fly_world<const N: usize>(
         if let Some(l) = per_track.get_mut(j) {
             *l = l.min(h - margin);
         }
-        match flown {
-            Ok(next) => state = next,
-            Err(_) => break,
-        }
-    }
-    (first, all)
-}
-
-/// The flight of track `track` at `z` from `st`, its end `next` on a knife
-/// edge, with the switch the other way, then `rest` (one depth per later
-/// track) from there: the least altitude on its own track, and on the
-/// later ones (`-inf` from a flight that fails), each later track's less
-/// `margin` also lowering `per_track` (from the track after `track`).
-/// The other way's own later edges are not branched again.
-#[inline(never)]
-pub(super) fn fly_other_way<const N: usize>(
-    scw: &Scenario<'_, N>,
-    (st, track): (&VehicleState<N>, usize),
-    (z, next): (f32, &VehicleState<N>),
-    rest: &[f32],
-    (margin, per_track): (f32, &mut [f32]),
-) -> (f32, f32) {
-    let Ok((own, mut state)) = scw.switched_other_way(st, track, z, next) else {
-        return (f32::NEG_INFINITY, f32::NEG_INFINITY);
-    };
-    let mut score = [TrackScore::default()];
-    let mut later = f32::INFINITY;
-    for (i, &zi) in rest.iter().enumerate() {
-        let t = track.saturating_add(1).saturating_add(i);
-        let flown = scw.fly(&state, t, &[zi], &mut score);
-        let h = match (&flown, score.first()) {
-            (Ok(_), Some(s)) => s.min_altitude(),
-            _ => f32::NEG_INFINITY,
+        let Ok(mut next) = flown else {
+            break;
         };
-        later = later.min(h);
-        if let Some(l) = per_track.get_mut(i) {
-            *l = l.min(h - margin);
+        if branch == Some(j) {
+            // (Track `j`'s own flight is the first one's, but for a
+            // sample past its waypoint, which the next track scores.)
+            // (`state` is used up: `next` follows.)
+            if scw
+                .switch_other_way((&mut state, &mut next), (t, z), &mut score)
+                .is_err()
+            {
+                all = f32::NEG_INFINITY;
+                break;
+            }
+        } else if branch.is_none()
+            && j < 64
+            && j.saturating_add(1) < depths.len()
+            && scw.on_edge(t, &next)
+        {
+            edges |= 1 << j;
         }
-        match flown {
-            Ok(n) => state = n,
-            Err(_) => break,
-        }
+        state = next;
     }
-    (own.min_altitude(), later)
+    Ok((first, all, edges))
 }
 
 /// Certifies a fixed line (model contract §12): `depths` (one per track

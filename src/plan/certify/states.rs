@@ -124,7 +124,7 @@ impl<const N: usize> Tube<N> {
     /// Adds a branch ([`Tube::branches`]): `world` (the nominal one) again,
     /// from `state`, where the last committed depth's nominal flight
     /// reached the track the tube is at with its switch the other way
-    /// ([`Scenario::switched_other_way`]). None is added where the worlds
+    /// ([`Scenario::switch_other_way`]). None is added where the worlds
     /// are full or the tube holds no states.
     pub fn branch(&mut self, world: World, state: &VehicleState<N>) {
         let i = self.worlds.len();
@@ -312,7 +312,9 @@ mod tests {
         tube.prepare(worlds(), &start, 0);
         let mut s = [TrackScore::default()];
         let next = sc.fly(&start, 0, &[230.0], &mut s).unwrap();
-        let (_, other) = sc.switched_other_way(&start, 0, 230.0, &next).unwrap();
+        let (mut from, mut other) = (start, next);
+        sc.switch_other_way((&mut from, &mut other), (0, 230.0), &mut s)
+            .unwrap();
         let mut flights = 0;
         tube.advance((&sc, p.view()), 230.0, &next, (true, true, &mut flights));
         tube.branch(World::nominal(&v), &other);
