@@ -226,7 +226,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if fresh && self.budget.limit.saturating_sub(fl.count) >= 2 {
                 let rule = terrain_rule(sc, track, len);
                 let d = rule.get(..len).unwrap_or(&[]);
-                if let Ok((f, c)) = fly_line(sc, (state, track), d, (&mut fl.count, cap))
+                // (Its branch leaves the climb's flight.)
+                let spare = (&mut fl.count, cap.saturating_sub(1));
+                if let Ok((f, c)) = fly_line(sc, (state, track), d, spare)
                     && c.all >= h_safe
                 {
                     depths = rule;
