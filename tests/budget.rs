@@ -18,7 +18,8 @@ mod common;
 
 use auvnav::{
     Measurement, Mission, PlanError, Planner, PlannerConfig, Profile, Resumable, Scenario, Step,
-    TrackScore, Uncertainty, Vehicle, VehicleState, Waypoints, lower_envelope,
+    TrackScore, TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints,
+    lower_envelope,
 };
 use common::{real_profile, real_waypoints};
 
@@ -317,6 +318,73 @@ fn within_every_cap(sc: &Scenario<'_, 3>, name: &str, constrained: bool) {
                 p.iterations
             );
             st = p.next_state;
+        }
+    }
+}
+
+/// Column `col` of `tests/fixtures/horizon/FILE` (a CSV with a header).
+fn fixture_column(file: &str, col: usize) -> Vec<f32> {
+    let path = format!(
+        "{}/tests/fixtures/horizon/{file}",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| l.split(',').nth(col).unwrap().trim().parse().unwrap())
+        .collect()
+}
+
+/// The line whose track 2 ends on waypoint 2's knife edge
+/// (`tests/knife_edge.rs`, fixture `switch_later`, the `slow` vehicle of
+/// its `.toml`): every budget's calls stay within it though a certificate
+/// may fly an edge's other switch (`src/plan/certify/mod.rs`), the line
+/// is as safe as the unbudgeted one's, and the unbudgeted line stays
+/// above `h_a` whichever way each interior waypoint's switch falls
+/// (the waypoint moved 1.9 mm each way, the committed depths flown open
+/// loop).
+#[test]
+fn a_knife_edge_line_within_every_budget() {
+    let mut cfg = VehicleConfig {
+        speed: 1.0,
+        sample_time: 0.2,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 30.0;
+    cfg.autopilot.elevator_limit = 30.0;
+    let tf = TransferFunction::pitch(&[-0.3], &[1.0, 3.0, 1.2, 0.1]).unwrap();
+    let vehicle = Vehicle::new(&cfg, tf).unwrap();
+    let (x, b) = (
+        fixture_column("switch_later.csv", 0),
+        fixture_column("switch_later.csv", 1),
+    );
+    let map = Profile::<512>::new(&x, &b).unwrap();
+    let xs = fixture_column("switch_later.waypoints.csv", 1);
+    let wps = Waypoints::<8>::new(&xs).unwrap();
+    let mission = Mission::new(80.0, 60.0, [0.0, 6000.0]).unwrap();
+    let sc = Scenario::new(&vehicle, &map, &wps, mission).unwrap();
+    let free = fly_line(&sc, u32::MAX, false);
+    assert!(free.safe.iter().all(|&s| s), "{:?}", free.safe);
+    for budget in [1, 2, 3, 5, 10, 20, 50, 200] {
+        let run = fly_line(&sc, budget, false);
+        for (t, (&ok, h)) in run.safe.iter().zip(open_loop(&sc, &run.depths)).enumerate() {
+            assert!(!ok || h >= 60.0, "budget {budget} track {}: {h}", t + 1);
+        }
+        assert_as_safe(&free.safe, &run.safe, &format!("budget {budget}"));
+    }
+    for i in 1..xs.len() - 1 {
+        for dx in [-1.9e-3, 1.9e-3] {
+            let mut moved = xs.clone();
+            moved[i] += dx;
+            let w = Waypoints::<8>::new(&moved).unwrap();
+            let s2 = Scenario::new(&vehicle, &map, &w, mission).unwrap();
+            let least = open_loop(&s2, &free.depths);
+            assert!(
+                least.iter().all(|&h| h >= 60.0 - 1e-3),
+                "waypoint {i} moved {dx} m: {least:?}"
+            );
         }
     }
 }

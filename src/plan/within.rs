@@ -7,7 +7,7 @@ use crate::sim::{Scenario, SimError, TrackScore, VehicleState, World};
 
 use super::budget::Budget;
 use super::candidate::Candidate;
-use super::certify::{Certificate, fly_once};
+use super::certify::{Certificate, fly_world};
 use super::commit::{certification_bottom, nominal_only};
 use super::fallback::Flown;
 use super::flights::Flights;
@@ -304,9 +304,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 /// The nominal line flight of `depths` from `state` on `track` (one flight,
 /// over the map): the first track's flight and the certificate it is when
 /// the nominal world over the map is the only one. Where a track ends on
-/// its waypoint's knife edge, the rest is flown the other way too
-/// (`certify/mod.rs`) while `count` is below `cap` (one flight more;
-/// else the nominal switch alone, the contract's certificate).
+/// its waypoint's knife edge, the line is flown again as a certificate's
+/// world is, each edge's switch the other way too (`certify/mod.rs`),
+/// while `count` leaves room below `cap` (else the nominal switch alone,
+/// the contract's certificate).
 #[inline(never)]
 fn fly_line<const N: usize>(
     sc: &Scenario<'_, N>,
@@ -317,7 +318,7 @@ fn fly_line<const N: usize>(
     *count = count.saturating_add(1);
     let mut st = *state;
     let mut first: Option<Flown<N>> = None;
-    let mut all = f32::INFINITY;
+    let (mut all, mut branched) = (f32::INFINITY, false);
     for (j, &z) in depths.iter().enumerate() {
         let mut score = [TrackScore::default()];
         let t = track.saturating_add(j);
@@ -332,14 +333,16 @@ fn fly_line<const N: usize>(
                         next,
                     });
                 }
-                // (This track and the later ones; no flight left: the
-                // nominal switch alone, §11's.)
-                let from = depths.get(j..).unwrap_or(&[]);
-                if from.len() > 1 && sc.on_edge(t, &next) && *count < cap {
-                    *count = count.saturating_add(1);
-                    let nominal = (&World::nominal(sc.vehicle()), sc.profile());
-                    let other = fly_once(sc, nominal, (&st, t), from, (0.0, &mut []), Some(0));
-                    all = all.min(other.map_or(f32::NEG_INFINITY, |(_, a, _)| a));
+                // (Once: the whole line again, with every edge's branch;
+                // no flights left for it, the nominal switch alone, §11's.)
+                let more = j.saturating_add(1) < depths.len();
+                if more && !branched && sc.on_edge(t, &next) && count.saturating_add(1) < cap {
+                    branched = true;
+                    let (w, bottom) = (World::nominal(sc.vehicle()), sc.profile());
+                    let at = (state, track);
+                    let (_, a) =
+                        fly_world(sc, &w, bottom, at, depths, (0.0, &mut []), (count, cap));
+                    all = all.min(a);
                 }
                 st = next;
             }

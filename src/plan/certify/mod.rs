@@ -369,7 +369,7 @@ impl<const N: usize> Tube<N> {
 /// inside it, so that a certificate's stack holds one flight at a time.)
 #[allow(clippy::too_many_arguments)]
 #[inline(never)]
-fn fly_world<const N: usize>(
+pub(super) fn fly_world<const N: usize>(
     sc: &Scenario<'_, N>,
     w: &World,
     bottom: ProfileView<'_>,
@@ -417,7 +417,7 @@ fn fly_world<const N: usize>(
 /// # Errors
 /// [`SimError`] for a waypoint outside `bottom`.
 #[inline(always)]
-pub(super) fn fly_once<const N: usize>(
+fn fly_once<const N: usize>(
     sc: &Scenario<'_, N>,
     (w, bottom): (&World, ProfileView<'_>),
     (st, track): (&VehicleState<N>, usize),
