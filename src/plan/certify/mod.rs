@@ -456,6 +456,8 @@ fn fly_once<const N: usize>(
                 .is_err()
             {
                 all = f32::NEG_INFINITY;
+                let later = per_track.get_mut(j.saturating_add(1)..).unwrap_or(&mut []);
+                later.iter_mut().for_each(|l| *l = f32::NEG_INFINITY);
                 break;
             }
         } else if branch.is_none()
