@@ -389,27 +389,14 @@ fn check_contract<const N: usize, const K: usize>(
             plan.min_altitude
         );
     }
+    assert_eq!(
+        plan.certified_min_altitude.to_bits(),
+        plan.min_altitude.to_bits(),
+        "certified {} vs nominal {} with nothing declared",
+        plan.certified_min_altitude,
+        plan.min_altitude
+    );
     let horizon_constrained = cfg.mode == Mode::Horizon && cfg.constrained;
-    // In horizon mode, constrained, a call after a committed track that
-    // ended on its waypoint's knife edge also certifies from the other
-    // switch's state (a branch world: `src/plan/certify/`), which can only
-    // lower the certificate.
-    if horizon_constrained {
-        assert!(
-            plan.certified_min_altitude <= plan.min_altitude,
-            "certified {} above nominal {} with nothing declared",
-            plan.certified_min_altitude,
-            plan.min_altitude
-        );
-    } else {
-        assert_eq!(
-            plan.certified_min_altitude.to_bits(),
-            plan.min_altitude.to_bits(),
-            "certified {} vs nominal {} with nothing declared",
-            plan.certified_min_altitude,
-            plan.min_altitude
-        );
-    }
     if !horizon_constrained && !plan.safe {
         assert!(plan.min_altitude < h_safe, "{plan:?}");
     }

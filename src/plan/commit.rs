@@ -130,7 +130,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.line_j += flown.score.j();
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
         let status = self.status(sc, cand, &chosen, safe);
-        Ok(self.answer(flown, &chosen, cand, (status, safe), flights))
+        // The declared worlds' least altitude: with nothing declared, the
+        // nominal flight's (a branch world is no declared world: it only
+        // makes the certificate, so `safe`, stricter: spec/cli.md).
+        let certified = if nominal(sc) {
+            flown.score.min_altitude()
+        } else {
+            chosen.cert.first
+        };
+        Ok(self.answer(flown, cand, (status, safe, certified), flights))
     }
 
     /// [`Planner::choose`], with the chosen depth's nominal flight.
@@ -507,9 +515,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     fn answer(
         &mut self,
         f: Flown<N>,
-        chosen: &Chosen<N>,
         cand: &Candidate<N>,
-        (status, safe): (PlanStatus, bool),
+        (status, safe, certified): (PlanStatus, bool, f32),
         evaluations: u32,
     ) -> Plan<N> {
         let plan = Plan {
@@ -520,7 +527,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             j: f.score.j(),
             rms: f.score.rms(),
             min_altitude: f.score.min_altitude(),
-            certified_min_altitude: chosen.cert.first,
+            certified_min_altitude: certified,
             objective: self.work.j,
             iterations: cand.iterations,
             evaluations,
