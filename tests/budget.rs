@@ -21,7 +21,7 @@ use auvnav::{
     TrackScore, TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints,
     lower_envelope,
 };
-use common::{real_profile, real_waypoints};
+use common::{csv_column, real_profile, real_waypoints};
 
 const LINES: [(&str, f32, f32); 6] = [
     ("us_monterey_canyon_1", 80.0, 60.0),
@@ -324,17 +324,7 @@ fn within_every_cap(sc: &Scenario<'_, 3>, name: &str, constrained: bool) {
 
 /// Column `col` of `tests/fixtures/horizon/FILE` (a CSV with a header).
 fn fixture_column(file: &str, col: usize) -> Vec<f32> {
-    let path = format!(
-        "{}/tests/fixtures/horizon/{file}",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    std::fs::read_to_string(path)
-        .unwrap()
-        .lines()
-        .skip(1)
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').nth(col).unwrap().trim().parse().unwrap())
-        .collect()
+    csv_column(&format!("tests/fixtures/horizon/{file}"), col)
 }
 
 /// The line whose track 2 ends on waypoint 2's knife edge

@@ -66,7 +66,7 @@ const J_SHARE: f32 = 1e-3;
 /// the README's declared uncertainty: a call moved off an edge lost its
 /// continuation's certificate and searched, 159 flights against 12).
 pub(super) fn nominal<const N: usize>(sc: &Scenario<'_, N>) -> bool {
-    *sc.mission().uncertainty() == crate::model::Uncertainty::NONE
+    sc.mission().uncertainty().is_none()
 }
 
 impl<const K: usize, const N: usize> Planner<K, N> {

@@ -119,7 +119,7 @@
 //! (track 1 at 1 006 m), with track 4 held by track 3. Lifted there, the
 //! line goes from 1.186× to 1.082× the f64 best safe `J`. On 267 random
 //! lines 6 move, all lower (`unseen_3111_6` −5.3 %, safe), 5.8 flights a
-//! line more; the 24 shared runs keep their plans and flights. (Round 21
+//! line more; the 18 shared runs keep their plans and flights. (Round 21
 //! measured the lift repeated in every round: 14.7 to 49 flights a line.)
 //!
 //! A later track counts as held at its target within a hundredth of the

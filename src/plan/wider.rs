@@ -103,7 +103,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// and the warm calls kept its continuation: 1.20× the f64 best safe
     /// `J`; the second call's held edge takes it to 1.0003×. On 267 random
     /// lines 17 move, none higher (13 of them lines with no safe plan
-    /// found either way), 11.6 flights a line more; the 24 shared runs
+    /// found either way), 11.6 flights a line more; the 18 shared runs
     /// the same plans and flights (their cold calls end feasible). None
     /// where they are not `due` (a warm call owed nothing).
     pub(super) fn cold_escapes(

@@ -87,32 +87,27 @@ pub fn vehicle(v: &Value) -> (Vehicle<N>, Mission, f32) {
     )
 }
 
-/// Reads a bundled profile CSV (`x_m,bottom_depth_m`).
-pub fn real_profile(name: &str) -> (Vec<f32>, Vec<f32>) {
-    let path = format!("{}/data/bathymetry/{name}.csv", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut x = Vec::new();
-    let mut b = Vec::new();
-    for line in text.lines().skip(1).filter(|l| !l.trim().is_empty()) {
-        let mut it = line.split(',');
-        x.push(it.next().unwrap().trim().parse().unwrap());
-        b.push(it.next().unwrap().trim().parse().unwrap());
-    }
-    (x, b)
-}
-
-/// Reads a bundled waypoint CSV (`wp,x_m,...`).
-pub fn real_waypoints(name: &str) -> Vec<f32> {
-    let path = format!(
-        "{}/data/bathymetry/{name}.waypoints.csv",
-        env!("CARGO_MANIFEST_DIR")
-    );
+/// Column `col` of a CSV file under the crate (`rel`, from the manifest
+/// directory), its header skipped.
+pub fn csv_column(rel: &str, col: usize) -> Vec<f32> {
+    let path = format!("{}/{rel}", env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(path).unwrap();
     text.lines()
         .skip(1)
         .filter(|l| !l.trim().is_empty())
-        .map(|l| l.split(',').nth(1).unwrap().trim().parse().unwrap())
+        .map(|l| l.split(',').nth(col).unwrap().trim().parse().unwrap())
         .collect()
+}
+
+/// Reads a bundled profile CSV (`x_m,bottom_depth_m`).
+pub fn real_profile(name: &str) -> (Vec<f32>, Vec<f32>) {
+    let rel = format!("data/bathymetry/{name}.csv");
+    (csv_column(&rel, 0), csv_column(&rel, 1))
+}
+
+/// Reads a bundled waypoint CSV (`wp,x_m,...`).
+pub fn real_waypoints(name: &str) -> Vec<f32> {
+    csv_column(&format!("data/bathymetry/{name}.waypoints.csv"), 1)
 }
 
 /// A fixture case's profile: a real profile's name or an inline `{x, b}`.
