@@ -139,7 +139,9 @@ def random_vehicle(rng: random.Random, prof: ar.Profile, X0: float):
         cfg["plant"] = dict(PLANTS[name])
         if rng.random() < 0.3:
             cfg["initial_depth"] = sig(prof(X0) - h_r + rng.uniform(-40.0, 40.0), 6)
-            cfg["initial_depth"] = max(cfg["initial_depth"], 1.0)
+            # (above the bottom: the draw reaches 40 m below b - h_r, and
+            # h_r may be as little as 20 m)
+            cfg["initial_depth"] = max(min(cfg["initial_depth"], sig(prof(X0) - 0.3 * h_r, 6)), 1.0)
         if rng.random() < 0.2:
             cfg["optimizer"] = {"max_iterations": rng.choice([50, 100, 200])}
         # drop some keys now and then: the tool must fill in the defaults
