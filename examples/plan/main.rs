@@ -187,6 +187,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
     // Fixed depths are certified here: flown open loop in every declared
     // world over the certification bottom (the planner certifies its own).
     let fixed_cert = certify_open_loop(&scenario, &start, &report_base.depths)?;
+    let declared = !uncertainty.is_none();
     let report = Report {
         profile: profile_label,
         vehicle: vehicle_label,
@@ -201,7 +202,10 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
             .zip(&report_base.optimizer)
             .zip(&fixed_cert)
             .map(|(((s, &depth), eff), &fixed)| {
-                let (certified_min_altitude, safe) = eff.certified.unwrap_or(fixed);
+                let (certified_min_altitude, safe, status) = match eff.certified {
+                    Some(planned) => no_better_than_the_line(planned, fixed, declared, eff.status),
+                    None => (fixed.0, fixed.1, eff.status),
+                };
                 let safe = safe && !eff.after_crash;
                 TrackReport {
                     x_start: s.x_start(),
@@ -214,7 +218,7 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
                     safe,
                     iterations: eff.iterations,
                     evaluations: eff.evaluations,
-                    status: eff.status,
+                    status,
                     optimizer: eff.optimizer,
                     continuation: eff.continuation.clone(),
                     j_history: eff.j_history.clone(),
@@ -371,6 +375,33 @@ fn sanity(
         ));
     }
     Ok(warnings)
+}
+
+/// A planned track's certificate as reported: the planner's (`planned`:
+/// least altitude, m, and safe), no better than the line's open-loop one
+/// from the start (`line`), with the track's `status`. The two agree while
+/// the planner's worlds are carried from the start. After a predicted
+/// collision the planner starts again from the climb's state, and its
+/// worlds no longer carry the spread the declared worlds had built up by
+/// then; spec/cli.md's promise is for the line flown open loop from the
+/// start state. With nothing `declared` the altitude stays the nominal
+/// flight's (equal to `min_altitude`) and only `safe` takes the line's (a
+/// knife edge's other switch). A track the line does not certify is not
+/// safe: `infeasible`.
+fn no_better_than_the_line(
+    (planned, planned_safe): (f32, bool),
+    (line, line_safe): (f32, bool),
+    declared: bool,
+    status: &'static str,
+) -> (f32, bool, &'static str) {
+    let certified = if declared { planned.min(line) } else { planned };
+    let safe = planned_safe && line_safe;
+    let status = if planned_safe && !safe {
+        "infeasible"
+    } else {
+        status
+    };
+    (certified, safe, status)
 }
 
 /// Each track's least altitude over the declared worlds and whether it is
