@@ -257,7 +257,8 @@ fn the_plan_does_not_depend_on_the_capacity() {
 /// climbs it and plans track 5 from the climb's state, where the planner's
 /// worlds start again. Track 5 was reported safe with 143.8 m certified;
 /// sinking with the current over the map shifted back and raised, the line
-/// flew it at 38.5 m (checker, f64). The tool now reports each planned
+/// flew it at 38.5 m (checker, f64). The climb now carries the planner's
+/// worlds through it (`Planner::carry`), and the tool reports each planned
 /// track's certificate no better than the line's from the start.
 #[test]
 fn a_track_planned_after_a_predicted_collision_is_certified_from_the_start() {

@@ -380,11 +380,11 @@ fn sanity(
 /// A planned track's certificate as reported: the planner's (`planned`:
 /// least altitude, m, and safe), no better than the line's open-loop one
 /// from the start (`line`), with the track's `status`. The two agree while
-/// the planner's worlds are carried from the start. After a predicted
-/// collision the planner starts again from the climb's state, and its
-/// worlds no longer carry the spread the declared worlds had built up by
-/// then; spec/cli.md's promise is for the line flown open loop from the
-/// start state. With nothing `declared` the altitude stays the nominal
+/// the planner's worlds are carried from the start (through a climb too:
+/// `Planner::carry`); a planner whose worlds started again from a later
+/// state would not carry the spread the declared worlds had built up by
+/// then, and spec/cli.md's promise is for the line flown open loop from
+/// the start state. With nothing `declared` the altitude stays the nominal
 /// flight's (equal to `min_altitude`) and only `safe` takes the line's (a
 /// knife edge's other switch). A track the line does not certify is not
 /// safe: `infeasible`.
@@ -466,8 +466,9 @@ fn plan_line(
                     after_crash: true,
                     ..Effort::fixed()
                 });
-                let mut score = [auvnav::TrackScore::default()];
-                match scenario.simulate(&state, n, &[shallow], &mut score, |_| {}) {
+                // (The planner's worlds fly the climb too: the next
+                // track's certificates keep their spread from the start.)
+                match planner.carry(scenario, &state, n, shallow) {
                     Ok(next) => {
                         state = next;
                         continue;

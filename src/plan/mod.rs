@@ -122,6 +122,7 @@
 //! | `resumable.rs` | [`Resumable`]: one call as bounded steps |
 //! | `candidate.rs` | one call's candidate, step by step |
 //! | `commit.rs` | what is committed: the certified continuation (§11) |
+//! | `carry.rs` | a track flown at a depth the planner did not choose: the worlds carried through it |
 //! | `search.rs` | the continuation search from a certified anchor (§11) |
 //! | `gaps.rs` | the SQP's targets raised by the certification gap (§12) |
 //! | `certify/` | certificates over the declared worlds (§12), [`certify_line`]; the worlds' states between calls (`states.rs`) |
@@ -135,6 +136,7 @@
 mod answer;
 mod budget;
 mod candidate;
+mod carry;
 mod certify;
 mod commit;
 mod config;
