@@ -163,7 +163,16 @@ mod firmware {
 
     #[entry]
     fn main() -> ! {
-        let Ok(vehicle) = Vehicle::c_auv4() else {
+        // Once, at configuration: the validation and its stability check
+        // (32 768 steps of the linearized loop).
+        let validated = measure(
+            "vehicle",
+            "vehicle validation (Vehicle::c_auv4, its stability check)",
+            1.0,
+            "call",
+            Vehicle::c_auv4,
+        );
+        let Ok(vehicle) = validated else {
             exit(false)
         };
         let Ok(bottom) = Profile::<S>::new(&monterey::X, &monterey::B) else {
