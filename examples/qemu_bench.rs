@@ -164,7 +164,7 @@ mod firmware {
     #[entry]
     fn main() -> ! {
         // Once, at configuration: the validation and its stability check
-        // (32 768 steps of the linearized loop).
+        // (20 480 steps of the linearized loop).
         let validated = measure(
             "vehicle",
             "vehicle validation (Vehicle::c_auv4, its stability check)",
