@@ -256,6 +256,19 @@ fn plan_line<const N: usize, const K: usize>(
                 state = plan.next_state;
                 last = Some(plan.status);
             }
+            // A predicted start in the rock: the tool's climb, with the
+            // worlds carried through it (`Planner::carry`), then on.
+            Err(PlanError::StartBelowBottom) if done > 0 => {
+                let shallow = sc.mission().depth_limits()[0];
+                match planner.carry(sc, &state, track, shallow) {
+                    Ok(next) => {
+                        assert!(state_is_finite(&next), "carry: a state not finite");
+                        assert!(planner.continuation().is_empty());
+                        state = next;
+                    }
+                    Err(e) => return Outcome::Error(done, e, physical),
+                }
+            }
             Err(e) => {
                 if track >= tracks {
                     assert_eq!(e, PlanError::TrackRange);
