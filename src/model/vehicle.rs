@@ -7,7 +7,7 @@ use super::plant::{Plant, TransferFunction};
 
 /// Power-iteration steps of the stability check (4 096 to settle on the
 /// dominant mode, then the window), and the window over which the growth
-/// is measured (on the M4F about 3.7 M instructions, once, at
+/// is measured (on the M4F about 4.0 M instructions, once, at
 /// configuration). The window is long against the loop's slowest
 /// modes: a slow, damped oscillation (a complex pair of modulus just under
 /// 1, whose eigenvectors are far from orthogonal) swells a disturbance's
