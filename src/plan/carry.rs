@@ -35,7 +35,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let bottom = certification_bottom(sc)?;
         let mut score = [TrackScore::default()];
         let next = sc.fly(state, track, &[depth], &mut score)?;
-        self.tube.prepare_for(sc, state, track);
+        if !self.tube.prepare_for(sc, state, track) {
+            // (As a commit: `J` is weighed from where the worlds start.)
+            self.line_j = 0.0;
+        }
         let only_nominal = nominal_only(sc, bottom, &self.tube, state);
         let lazy = self.cfg.max_evaluations == u32::MAX;
         let mut flights = 0;
