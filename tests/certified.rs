@@ -14,10 +14,11 @@ mod common;
 mod tool;
 
 use auvnav::{
-    Mission, Planner, PlannerConfig, Profile, Scenario, TrackScore, Uncertainty, Vehicle,
-    VehicleState, Waypoints, World, lower_envelope,
+    Mission, Mode, PidGains, Planner, PlannerConfig, Profile, Scenario, TrackScore,
+    TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints, World,
+    lower_envelope,
 };
-use common::{real_profile, real_waypoints};
+use common::{csv_column, real_profile, real_waypoints};
 
 struct Lcg(u64);
 impl Lcg {
@@ -323,4 +324,93 @@ fn a_track_planned_after_a_predicted_collision_is_certified_from_the_start() {
             &format!("{name} {mode}"),
         );
     }
+}
+
+/// With little vehicle uncertainty declared (a flight-path offset of
+/// 0.065°, a map known to 6.88 m along track), the worlds between the
+/// certificate's samples cross each waypoint up to a sample before or
+/// after them, and their flights after the switch are shifted by as much.
+/// A vehicle margin of 15 s of drift (27 mm) did not cover it: on this
+/// random line and vehicle (`check_certified.py --seed 2431`,
+/// `synthetic_031`, fixture `offset_jitter`), an interior offset flew track
+/// 4 40 mm under the corners. One sample's climb at the pitch limit
+/// (72 mm) does. Each track's certified altitude is at most its least
+/// altitude in 81 worlds across the declared offset, over the map shifted
+/// either way.
+#[test]
+fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
+    let mut cfg = VehicleConfig {
+        speed: 1.565,
+        sample_time: 0.185,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 13.94;
+    cfg.autopilot.elevator_limit = 16.84;
+    cfg.autopilot.pitch_pid = PidGains {
+        kp: 1.696,
+        ki: 0.1005,
+        kd: 2.204,
+    };
+    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
+    let alpha_max = 0.0649;
+    let u = Uncertainty::new(6.88, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
+    let rel = "tests/fixtures/horizon/offset_jitter";
+    let (x, b) = (
+        csv_column(&format!("{rel}.csv"), 0),
+        csv_column(&format!("{rel}.csv"), 1),
+    );
+    let map = Profile::<4096>::new(&x, &b).unwrap();
+    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
+    let x0 = wps.positions()[0];
+    let env = lower_envelope::<12288>(map.view(), &u, x0).unwrap();
+    let mission = Mission::new(65.95, 33.03, [0.0, 6000.0])
+        .unwrap()
+        .with_uncertainty(u);
+    let sc = Scenario::new(&vehicle, &map, &wps, mission)
+        .unwrap()
+        .with_certification_bottom(env.view())
+        .unwrap();
+    let start = sc.start_state(1065.47);
+    let mut rng = Lcg(0x2431_0ff5);
+    let shifted: Vec<Profile<8192>> = [1.0, -1.0]
+        .iter()
+        .map(|&s| world_bottom(&map, &u, x0, &mut rng, Some((s, 0.0))))
+        .collect();
+    let mut checked = 0;
+    for mode in [Mode::TrackWise, Mode::Horizon] {
+        let cfg = PlannerConfig {
+            mode,
+            ..PlannerConfig::default()
+        };
+        let mut planner = Planner::<5>::new(cfg).unwrap();
+        let (mut st, mut depths, mut certified) = (start, Vec::new(), Vec::new());
+        for n in 0..wps.tracks() {
+            let Ok(p) = planner.plan(&sc, &st, n) else {
+                break;
+            };
+            depths.push(p.depth);
+            certified.push(p.certified_min_altitude);
+            st = p.next_state;
+        }
+        for k in 0..=80 {
+            let world = World {
+                speed: vehicle.speed(),
+                flight_path_offset: alpha_max * (k as f32 / 40.0 - 1.0),
+                vertical_current: 0.0,
+            };
+            for bottom in &shifted {
+                let least = fly(&sc, &world, bottom, &start, &depths);
+                for (t, (&h, &c)) in least.iter().zip(&certified).enumerate() {
+                    assert!(
+                        c <= h + 1e-3,
+                        "{mode:?} track {}: certified {c} m, flies {h} m at α = {}°",
+                        t + 1,
+                        world.flight_path_offset
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 600, "{checked}");
 }
