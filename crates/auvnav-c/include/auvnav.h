@@ -342,6 +342,17 @@ int32_t auvnav_planner_set_line(auvnav_planner *p,
 int32_t auvnav_plan_next(auvnav_planner *p,
                          auvnav_plan *out);
 
+// Flies the next track at reference depth `depth` (m), a depth the
+// planner did not plan (the climb after `AUVNAV_ERR_BELOW_BOTTOM`, an
+// operator's override), carrying the declared worlds through it, and
+// advances to the track after it: the next `auvnav_plan_next` certifies
+// from the worlds' spread, as the `plan` tool does after its climb.
+//
+// # Safety
+// `p` is null or a valid planner.
+int32_t auvnav_planner_carry(auvnav_planner *p,
+                             float depth);
+
 // Replaces the held state by what the vehicle measured (the rest of the
 // model state kept from the prediction), for the next
 // `auvnav_plan_next`.

@@ -305,6 +305,24 @@ pub unsafe extern "C" fn auvnav_plan_next(p: *mut auvnav_planner, out: *mut auvn
     }
 }
 
+/// Flies the next track at reference depth `depth` (m), a depth the
+/// planner did not plan (the climb after `AUVNAV_ERR_BELOW_BOTTOM`, an
+/// operator's override), carrying the declared worlds through it, and
+/// advances to the track after it: the next `auvnav_plan_next` certifies
+/// from the worlds' spread, as the `plan` tool does after its climb.
+///
+/// # Safety
+/// `p` is null or a valid planner.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn auvnav_planner_carry(p: *mut auvnav_planner, depth: f32) -> i32 {
+    // SAFETY: the caller's contract for `p`.
+    let planner = match unsafe { ready::<PlannerInner>(p.cast(), PLANNER_READY) } {
+        Ok(planner) => planner,
+        Err(e) => return e,
+    };
+    code(planner.carry(depth))
+}
+
 /// Replaces the held state by what the vehicle measured (the rest of the
 /// model state kept from the prediction), for the next
 /// `auvnav_plan_next`.

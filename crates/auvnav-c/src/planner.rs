@@ -141,6 +141,22 @@ impl<const N: usize> Core<N> {
         })
     }
 
+    fn carry(
+        &mut self,
+        line: &Line,
+        mission: Mission,
+        track: usize,
+        depth: f32,
+    ) -> Result<(), Code> {
+        let sc = scenario(&self.vehicle, line, mission)?;
+        let next = self
+            .planner
+            .carry(&sc, &self.state, track, depth)
+            .map_err(error::plan)?;
+        self.state = next;
+        Ok(())
+    }
+
     fn measured(&mut self, m: &auvnav_measurement) -> Result<(), Code> {
         let m = Measurement {
             x: m.x,
@@ -217,6 +233,19 @@ impl PlannerInner {
         let plan = with_core!(&mut self.engine, c => c.plan(line, mission, track))?;
         self.track = self.track.saturating_add(1);
         Ok(plan)
+    }
+
+    /// Flies the next track at `depth` (m), which the planner did not
+    /// plan, its worlds carried through (`Planner::carry`), and advances.
+    pub(crate) fn carry(&mut self, depth: f32) -> Result<(), Code> {
+        let line = self.line.as_ref().ok_or(AUVNAV_ERR_NO_LINE)?;
+        if self.track >= line.waypoints.tracks() {
+            return Err(AUVNAV_ERR_LINE_DONE);
+        }
+        let (mission, track) = (self.mission, self.track);
+        with_core!(&mut self.engine, c => c.carry(line, mission, track, depth))?;
+        self.track = self.track.saturating_add(1);
+        Ok(())
     }
 
     /// Replaces the held state by the measured one.

@@ -6,7 +6,9 @@
    1. Every shared profile planned with auvnav_plan_next, track by track:
       the same depths, statuses, minimum altitudes (and certified minimum
       altitudes, safety, optimizer stops) as `plan --json --horizon 5`,
-      compared bit for bit with the tool's printed values.
+      compared bit for bit with the tool's printed values; a track whose
+      predicted start is below the bottom climbed with auvnav_planner_carry,
+      as the tool climbs it.
    2. Every function, every error code of capi.md: null pointers, NaN,
       over-capacity lengths, invalid settings, uninitialized objects. */
 #include "auvnav.h"
@@ -53,10 +55,11 @@ static float infinity(void) { volatile float z = 0.0f; return 1.0f / z; }
 static int failures;
 static int checks;
 static uint32_t stack_max[8];
-enum { S_INIT, S_SET_LINE, S_PLAN_NEXT, S_MEASURED, S_AP_INIT, S_AP_STEP, S_N };
+enum { S_INIT, S_SET_LINE, S_PLAN_NEXT, S_CARRY, S_MEASURED, S_AP_INIT, S_AP_STEP, S_N };
 static const char *const STACK_NAME[S_N] = {
   "auvnav_planner_init", "auvnav_planner_set_line", "auvnav_plan_next",
-  "auvnav_planner_measured", "auvnav_autopilot_init", "auvnav_autopilot_step"};
+  "auvnav_planner_carry", "auvnav_planner_measured", "auvnav_autopilot_init",
+  "auvnav_autopilot_step"};
 
 static void put_u(uint32_t v) {
   char buf[11];
@@ -165,14 +168,21 @@ static void plan_line(const struct line *l) {
     test_write("  track ");
     put_u(t + 1);
     if (w->after_crash) {
-      /* The tool flies the tracks after a predicted collision at the
-         shallowest depth, unplanned; the planner has no start there. */
+      /* The tool flies a track whose predicted start is below the bottom
+         at the shallowest depth, unplanned, its worlds carried through
+         the climb, and plans on from where the climb ends: so does the
+         C caller. */
       test_write(": after the predicted collision: ");
       test_write(auvnav_error_name(rc));
-      test_write("\n");
+      test_write(", climbed\n");
       expect_code(rc, AUVNAV_ERR_BELOW_BOTTOM, "plan_next after a collision");
       check(auvnav_planner_track(&planner) == t + 1, "no advance on an error");
-      break;
+      test_stack_begin();
+      rc = auvnav_planner_carry(&planner, m.depth_min);
+      stack_note(S_CARRY);
+      expect_code(rc, AUVNAV_OK, "planner_carry (the climb)");
+      check(auvnav_planner_track(&planner) == t + 2, "carry advances");
+      continue;
     }
     expect_code(rc, AUVNAV_OK, "plan_next");
     test_write(": depth ");
@@ -198,7 +208,10 @@ static void plan_line(const struct line *l) {
     }
     test_write("\n");
   }
-  if (t == l->n_tracks) expect_code(auvnav_plan_next(&planner, &p), AUVNAV_ERR_LINE_DONE, "plan_next after the last track");
+  if (t == l->n_tracks) {
+    expect_code(auvnav_plan_next(&planner, &p), AUVNAV_ERR_LINE_DONE, "plan_next after the last track");
+    expect_code(auvnav_planner_carry(&planner, 10.0f), AUVNAV_ERR_LINE_DONE, "carry after the last track");
+  }
   check(same, "the depths, statuses and minimum altitudes equal plan --json's");
 }
 
@@ -304,6 +317,8 @@ static void init_errors(void) {
     expect_code(auvnav_planner_set_line(&never_inited, x, x, 2, x, 2, 0.0f), AUVNAV_ERR_NOT_INITIALIZED,
                 "set_line(never initialized)");
     expect_code(auvnav_planner_measured(&never_inited, &me), AUVNAV_ERR_NOT_INITIALIZED, "measured(never initialized)");
+    expect_code(auvnav_planner_carry(&never_inited, 10.0f), AUVNAV_ERR_NOT_INITIALIZED, "carry(never initialized)");
+    expect_code(auvnav_planner_carry(NULL, 10.0f), AUVNAV_ERR_NULL, "carry(NULL)");
     check(auvnav_planner_track(&never_inited) == 0 && auvnav_planner_track(NULL) == 0, "track(uninitialized, NULL) is 0");
     expect_code(auvnav_plan_next(NULL, &p), AUVNAV_ERR_NULL, "plan_next(NULL)");
     expect_code(auvnav_planner_measured(NULL, &me), AUVNAV_ERR_NULL, "measured(NULL)");
@@ -337,6 +352,7 @@ static void line_errors(void) {
   expect_code(auvnav_plan_next(&planner, &p), AUVNAV_ERR_NO_LINE, "plan_next before set_line");
   me.depth = 900.0f; me.pitch = 0.0f; me.pitch_rate = 0.0f; me.x = 0.0f;
   expect_code(auvnav_planner_measured(&planner, &me), AUVNAV_ERR_NO_LINE, "measured before set_line");
+  expect_code(auvnav_planner_carry(&planner, 10.0f), AUVNAV_ERR_NO_LINE, "carry before set_line");
   for (i = 0; i < n; i++) { big[i] = l->x[i]; big_b[i] = l->b[i]; }
 #define SET(x_, b_, ns_, w_, nw_, d_) auvnav_planner_set_line(&planner, x_, b_, ns_, w_, nw_, d_)
   expect_code(SET(NULL, l->b, n, l->w, l->n_waypoints, 0.0f), AUVNAV_ERR_NULL, "set_line(NULL x)");
@@ -366,6 +382,8 @@ static void line_errors(void) {
   expect_code(SET(l->x, l->b, n, l->w, l->n_waypoints, not_a_number()), AUVNAV_OK, "set_line");
 #undef SET
   expect_code(auvnav_plan_next(&planner, NULL), AUVNAV_ERR_NULL, "plan_next(NULL out)");
+  expect_code(auvnav_planner_carry(&planner, not_a_number()), AUVNAV_ERR_NON_FINITE, "carry(depth NaN)");
+  check(auvnav_planner_track(&planner) == 1, "no advance on a carry's error");
   expect_code(auvnav_planner_measured(&planner, NULL), AUVNAV_ERR_NULL, "measured(NULL)");
   me.depth = not_a_number();
   expect_code(auvnav_planner_measured(&planner, &me), AUVNAV_ERR_NON_FINITE, "measured(depth NaN)");
