@@ -172,9 +172,7 @@ mod firmware {
             "call",
             Vehicle::c_auv4,
         );
-        let Ok(vehicle) = validated else {
-            exit(false)
-        };
+        let Ok(vehicle) = validated else { exit(false) };
         let Ok(bottom) = Profile::<S>::new(&monterey::X, &monterey::B) else {
             exit(false)
         };
