@@ -122,7 +122,9 @@ def random_vehicle(rng: random.Random, prof: ar.Profile, X0: float):
         cfg["pitch_limit"] = sig(rng.uniform(10.0, 30.0))
         if rng.random() < 0.3:
             cfg["elevator_limit"] = sig(rng.uniform(15.0, 30.0))
-        h_r = sig(rng.uniform(20.0, 100.0))
+        # (h_r less than the water at X0, where the vehicle starts at
+        # b(X0) - h_r; the same draw otherwise)
+        h_r = sig(min(rng.uniform(20.0, 100.0), 0.9 * prof(X0)))
         cfg["reference_altitude"] = h_r
         cfg["min_altitude"] = sig(h_r * rng.uniform(0.4, 0.9))
         d = ar.DEFAULT_VEHICLE
