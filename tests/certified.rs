@@ -14,7 +14,7 @@ mod common;
 mod tool;
 
 use auvnav::{
-    Mission, Mode, PidGains, Planner, PlannerConfig, Profile, Scenario, TrackScore,
+    Mission, Mode, PidGains, Plan, Planner, PlannerConfig, Profile, Scenario, TrackScore,
     TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints, World,
     lower_envelope,
 };
@@ -90,6 +90,25 @@ fn fly(
         Ok(_) => s.iter().map(TrackScore::min_altitude).collect(),
         Err(_) => vec![f32::NEG_INFINITY; depths.len()],
     }
+}
+
+/// The line planned track by track from `start`, each call from the
+/// state the one before predicted, until a call fails (a start in the
+/// rock): each track's plan.
+fn plan_line<const K: usize>(
+    planner: &mut Planner<K>,
+    sc: &Scenario<'_, 3>,
+    start: &VehicleState<3>,
+) -> Vec<Plan<3>> {
+    let mut plans: Vec<Plan<3>> = Vec::new();
+    for n in 0..sc.waypoints().tracks() {
+        let st = plans.last().map_or(*start, |p| p.next_state);
+        let Ok(p) = planner.plan(sc, &st, n) else {
+            break;
+        };
+        plans.push(p);
+    }
+    plans
 }
 
 /// Flies `depths` open loop from `start` in the declared worlds of `u`
@@ -176,15 +195,9 @@ fn every_track_reported_safe_is_safe_in_sampled_worlds() {
                 .unwrap();
             let start = sc.start_state(sc.default_initial_depth());
             let mut planner = Planner::<8>::new(PlannerConfig::default()).unwrap();
-            let (mut st, mut depths, mut safe) = (start, Vec::new(), Vec::new());
-            for n in 0..wps.tracks() {
-                let Ok(p) = planner.plan(&sc, &st, n) else {
-                    break;
-                };
-                depths.push(p.depth);
-                safe.push(p.safe);
-                st = p.next_state;
-            }
+            let plans = plan_line(&mut planner, &sc, &start);
+            let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
+            let safe: Vec<bool> = plans.iter().map(|p| p.safe).collect();
             if depths.len() < wps.tracks() {
                 continue;
             }
@@ -383,15 +396,9 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
             ..PlannerConfig::default()
         };
         let mut planner = Planner::<5>::new(cfg).unwrap();
-        let (mut st, mut depths, mut certified) = (start, Vec::new(), Vec::new());
-        for n in 0..wps.tracks() {
-            let Ok(p) = planner.plan(&sc, &st, n) else {
-                break;
-            };
-            depths.push(p.depth);
-            certified.push(p.certified_min_altitude);
-            st = p.next_state;
-        }
+        let plans = plan_line(&mut planner, &sc, &start);
+        let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
+        let certified: Vec<f32> = plans.iter().map(|p| p.certified_min_altitude).collect();
         for k in 0..=80 {
             let world = World {
                 speed: vehicle.speed(),

@@ -169,6 +169,15 @@ impl<const N: usize> Core<N> {
     }
 }
 
+/// The line, when it has a track `track` (0-based) left to fly.
+fn track_left(line: Option<&Line>, track: usize) -> Result<&Line, Code> {
+    let line = line.ok_or(AUVNAV_ERR_NO_LINE)?;
+    if track >= line.waypoints.tracks() {
+        return Err(AUVNAV_ERR_LINE_DONE);
+    }
+    Ok(line)
+}
+
 impl PlannerInner {
     /// A planner for vehicle `v`, mission `m` and settings `s`, no line.
     pub(crate) fn new(
@@ -225,10 +234,7 @@ impl PlannerInner {
 
     /// Plans the next track and advances.
     pub(crate) fn plan_next(&mut self) -> Result<auvnav_plan, Code> {
-        let line = self.line.as_ref().ok_or(AUVNAV_ERR_NO_LINE)?;
-        if self.track >= line.waypoints.tracks() {
-            return Err(AUVNAV_ERR_LINE_DONE);
-        }
+        let line = track_left(self.line.as_ref(), self.track)?;
         let (mission, track) = (self.mission, self.track);
         let plan = with_core!(&mut self.engine, c => c.plan(line, mission, track))?;
         self.track = self.track.saturating_add(1);
@@ -238,10 +244,7 @@ impl PlannerInner {
     /// Flies the next track at `depth` (m), which the planner did not
     /// plan, its worlds carried through (`Planner::carry`), and advances.
     pub(crate) fn carry(&mut self, depth: f32) -> Result<(), Code> {
-        let line = self.line.as_ref().ok_or(AUVNAV_ERR_NO_LINE)?;
-        if self.track >= line.waypoints.tracks() {
-            return Err(AUVNAV_ERR_LINE_DONE);
-        }
+        let line = track_left(self.line.as_ref(), self.track)?;
         let (mission, track) = (self.mission, self.track);
         with_core!(&mut self.engine, c => c.carry(line, mission, track, depth))?;
         self.track = self.track.saturating_add(1);
