@@ -129,6 +129,13 @@ impl Uncertainty {
         self.horizontal > 0.0 || self.drift > 0.0 || self.vertical > 0.0
     }
 
+    /// Whether the vehicle's motion may differ from the model's (speed,
+    /// flight-path offset or vertical current declared): else the declared
+    /// worlds fly one vehicle, the nominal one.
+    pub fn motion_uncertain(&self) -> bool {
+        self.speed > 0.0 || self.flight_path_offset > 0.0 || self.vertical_current > 0.0
+    }
+
     /// The along-track offset bound `e(x) = e_h + r (x − X_0)` at `x` (m;
     /// `e_h` before `X_0`).
     pub fn offset_at(&self, x: f32, x0: f32) -> f32 {

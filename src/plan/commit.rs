@@ -28,7 +28,7 @@ use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
 use super::fallback::Flown;
 use super::flights::Flights;
-use super::knife::nominal;
+use super::knife::one_vehicle;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
@@ -94,7 +94,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The previous continuation on its waypoint's knife edge (`knife.rs`),
         // the candidate off it: the candidate's way instead.
         if chosen.previous
-            && nominal(sc)
+            && one_vehicle(sc)
             && sc.on_edge(track, &flown.next)
             && !sc.on_edge(track, &cand.flown.next)
         {
@@ -133,7 +133,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The declared worlds' least altitude: with nothing declared, the
         // nominal flight's (a branch world is no declared world: it only
         // makes the certificate, so `safe`, stricter: spec/cli.md).
-        let certified = if nominal(sc) {
+        let certified = if sc.mission().uncertainty().is_none() {
             flown.score.min_altitude()
         } else {
             chosen.cert.first

@@ -28,14 +28,14 @@
 //! `check_planner.py --seed 1801`, `unseen_1801_6` (horizon), track 4's
 //! climb reaches waypoint 4 0.1 mm past it whatever its depth, and track
 //! 5's `J` differs from the f64 re-simulation's by 2.1e-3. Under declared
-//! uncertainty nothing is moved ([`nominal`]).
+//! motion uncertainty nothing is moved ([`one_vehicle`]).
 //!
-//! What no move can avoid, the certificates fly both ways: with nothing
-//! declared, a certificate flies the rest of the line from the other
-//! switch's state too wherever a track ends on the edge
-//! (`certify/mod.rs`), and a committed depth that ends on it leaves that
-//! state in the tube as a branch, flown by every later certificate
-//! ([`Planner::branch_off_the_edge`]).
+//! What no move can avoid, the certificates fly both ways: with one
+//! vehicle world (nothing declared, or only the map), a certificate flies
+//! the rest of the line from the other switch's state too wherever a track
+//! ends on the edge (`certify/mod.rs`), and a committed depth that ends on
+//! it leaves that state in the tube as a branch, flown by every later
+//! certificate ([`Planner::branch_off_the_edge`]).
 //!
 //! In horizon mode, constrained, a call may commit the previous call's
 //! continuation instead of its candidate (`commit.rs`): where that
@@ -59,14 +59,19 @@ const MOST: f32 = 0.25;
 /// Most relative rise of the track's `J` a move may cost.
 const J_SHARE: f32 = 1e-3;
 
-/// Whether the mission declares no uncertainty. Under declared uncertainty
-/// the certificate's worlds fly the plan off the nominal flight by far
-/// more than a knife edge's hair (speed, current, map), and a moved depth
-/// would have to be certified again: the depth is kept (Monterey 1 with
-/// the README's declared uncertainty: a call moved off an edge lost its
-/// continuation's certificate and searched, 159 flights against 12).
-pub(super) fn nominal<const N: usize>(sc: &Scenario<'_, N>) -> bool {
-    sc.mission().uncertainty().is_none()
+/// Whether the declared worlds fly one vehicle, the nominal one: nothing
+/// declared, or only the map (its worlds differ in the bottom, which moves
+/// no state, so every world switches where the nominal flight does). Under
+/// declared motion (speed, path offset, current) the worlds fly the plan
+/// off the nominal flight by far more than a knife edge's hair, each
+/// switching at its own sample, and a moved depth would have to be
+/// certified again in each: the depth is kept (Monterey 1 with the
+/// README's declared uncertainty: a call moved off an edge lost its
+/// continuation's certificate and searched, 159 flights against 12), and
+/// the vehicle margin's floor of a sample's climb covers the switch
+/// (`certify/mod.rs`).
+pub(super) fn one_vehicle<const N: usize>(sc: &Scenario<'_, N>) -> bool {
+    !sc.mission().uncertainty().motion_uncertain()
 }
 
 impl<const K: usize, const N: usize> Planner<K, N> {
@@ -85,7 +90,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let Some(end) = sc.edge_waypoint(track) else {
             return;
         };
-        if cand.cert.is_some() || !nominal(sc) || !sc.on_edge(track, &cand.flown.next) {
+        if cand.cert.is_some() || !one_vehicle(sc) || !sc.on_edge(track, &cand.flown.next) {
             return;
         }
         let v0 = offset(&cand.flown.next, end);
@@ -112,15 +117,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
     }
 
-    /// With nothing declared, where the committed flight ends on its
-    /// waypoint's knife edge, the tube's branch from the other switch's
-    /// state (`Tube::branch`): the committed depth's certificate flew it
-    /// already (`certify/mod.rs`), and every later call's certificates fly
-    /// it too, so that the line stays certified however the vehicle's
-    /// arithmetic switches there. A budgeted call carries no branch: every
-    /// later call would fly it, and its least budget would be a flight
-    /// more (a budgeted call's certificates still fly an edge's other
-    /// switch when their flights allow, `certify/mod.rs`).
+    /// With one vehicle world ([`one_vehicle`]), where the committed
+    /// flight ends on its waypoint's knife edge, the tube's branch from
+    /// the other switch's state (`Tube::branch`): the committed depth's
+    /// certificate flew it already (`certify/mod.rs`), and every later
+    /// call's certificates fly it too, so that the line stays certified
+    /// however the vehicle's arithmetic switches there. A budgeted call
+    /// carries no branch: every later call would fly it, and its least
+    /// budget would be a flight more (a budgeted call's certificates still
+    /// fly an edge's other switch when their flights allow,
+    /// `certify/mod.rs`).
     #[inline(never)]
     pub(super) fn branch_off_the_edge(
         &mut self,
@@ -130,7 +136,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         flights: &mut u32,
     ) {
         let budgeted = self.budget.limit != u32::MAX;
-        if budgeted || !nominal(sc) || !sc.on_edge(track, &flown.next) {
+        if budgeted || !one_vehicle(sc) || !sc.on_edge(track, &flown.next) {
             return;
         }
         *flights = flights.saturating_add(1);
@@ -202,9 +208,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{Mission, Profile, Vehicle, Waypoints};
+    use crate::model::{Mission, Profile, Uncertainty, Vehicle, Waypoints};
     use crate::plan::status::Found;
-    use crate::plan::{Mode, OptimizerStop, PlannerConfig};
+    use crate::plan::{Mode, OptimizerStop, PlannerConfig, certify_line};
 
     /// Track 1 flown at `z`: its score and the state past waypoint 1.
     fn fly(sc: &Scenario<'_, 3>, start: &VehicleState<3>, z: f32) -> Flown<3> {
@@ -296,5 +302,55 @@ mod tests {
             (c.flown.depth.to_bits(), c.evaluations),
             (edge.depth.to_bits(), 0)
         );
+    }
+
+    /// With only the map declared (one vehicle world), a certificate of a
+    /// line whose first track ends on its waypoint's knife edge bounds the
+    /// next track's flight from either switch: the f64 checker's flight of
+    /// the same depths may switch the other way, and no vehicle margin
+    /// covers a sample's shift there.
+    #[test]
+    fn with_only_the_map_declared_a_certificate_flies_both_switches() {
+        let v = Vehicle::c_auv4().unwrap();
+        let (xs, bs) = ([0.0, 400.0, 700.0, 1500.0], [300.0, 300.0, 180.0, 200.0]);
+        let p = Profile::<8>::new(&xs, &bs).unwrap();
+        let w = Waypoints::<4>::new(&[0.0, 600.0, 1400.0]).unwrap();
+        let sc = Scenario::new(&v, &p, &w, Mission::default()).unwrap();
+        let start = sc.start_state(220.0);
+        let edge = on_the_edge(&sc, &start, 600.0);
+        // The map 2 m shallower: the certification bottom of e_v = 2 m.
+        let u = Uncertainty::new(0.0, 0.0, 2.0, 0.0, 0.0, 0.0).unwrap();
+        let raised = Profile::<8>::new(&xs, &bs.map(|b| b - 2.0)).unwrap();
+        let scu = Scenario::new(&v, &p, &w, Mission::default().with_uncertainty(u)).unwrap();
+        let over = sc.in_world(&World::nominal(&v), raised.view()).unwrap();
+        let mut other = edge.next;
+        let mut s = [TrackScore::default()];
+        over.switch_other_way((&mut start.clone(), &mut other), (0, edge.depth), &mut s)
+            .unwrap();
+        let mut apart = 0.0_f32;
+        for z2 in [100.0, 130.0, 160.0, 190.0, 220.0, 250.0] {
+            let mut least = [0.0; 2];
+            certify_line(
+                &scu,
+                raised.view(),
+                &start,
+                (0, &[edge.depth, z2]),
+                &mut least,
+            )
+            .unwrap();
+            let h = |from: &VehicleState<3>| {
+                let mut s = [TrackScore::default()];
+                over.fly(from, 1, &[z2], &mut s).unwrap();
+                s[0].min_altitude()
+            };
+            let (nominal, switched) = (h(&edge.next), h(&other));
+            assert!(
+                least[1] <= nominal.min(switched),
+                "{z2}: {least:?}, {nominal}, {switched}"
+            );
+            apart = apart.max(nominal - switched);
+        }
+        // The other switch flies lower somewhere: the test can fail.
+        assert!(apart > 1e-3, "{apart}");
     }
 }

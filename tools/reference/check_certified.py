@@ -95,6 +95,18 @@ def zero_bounds():
     return {k: 0.0 for k in RANGES}
 
 
+MAP_KEYS = ("horizontal_uncertainty", "nav_drift", "vertical_uncertainty")
+
+
+def restrict(b, kind):
+    """The bounds `b` with only the map's keys (kind "map") or only the
+    vehicle's motion keys (kind "motion") kept; "all" keeps every key."""
+    if kind == "all":
+        return b
+    keep = (lambda k: k in MAP_KEYS) if kind == "map" else (lambda k: k not in MAP_KEYS)
+    return {k: (v if keep(k) else 0.0) for k, v in b.items()}
+
+
 def make_cases(a):
     cases = []
     if not a.no_real:
@@ -110,7 +122,7 @@ def make_cases(a):
             base = {"reference_altitude": h_r, "min_altitude": h_a}
             rng = random.Random(f"{a.seed}/real/{name}")
             vs = min(1.0, (h_r - h_a) / 20.0)
-            blist = [zero_bounds()] + [random_bounds(rng, vs)
+            blist = [zero_bounds()] + [restrict(random_bounds(rng, vs), a.bounds_kind)
                                        for _ in range(a.bounds_per_profile)]
             for j, bd in enumerate(blist):
                 cases.append({"name": f"{name}/b{j}", "profile": P, "waypoints": Wp,
@@ -126,6 +138,7 @@ def make_cases(a):
         cfg, plant = cp.random_vehicle(rng, prof, X[0])
         cfg.pop("optimizer", None)  # keep the tool's default effort
         bd = zero_bounds() if (i % 4 == 0 or rng.random() < 0.1) else random_bounds(rng)
+        bd = restrict(bd, a.bounds_kind)
         cases.append({"name": f"{name}[{plant}]", "xs": xs, "bs": bs, "X": X,
                       "cfg": cfg, "bounds": bd})
     return cases
@@ -375,6 +388,9 @@ def main(argv=None):
     ap.add_argument("--random-worlds", type=int, default=8,
                     help="random motions and random bottoms each (default 8)")
     ap.add_argument("--modes", default="horizon", help="comma list of horizon,track")
+    ap.add_argument("--bounds-kind", choices=("all", "map", "motion"), default="all",
+                    help="keep only the map's bounds (e_h, r, e_v) or only the motion's "
+                         "(eps_U, alpha, w) of each random draw (default all)")
     ap.add_argument("--seed", type=int, default=20240612)
     ap.add_argument("--alt-tol", type=float, default=0.01)
     ap.add_argument("--timeout", type=float, default=1800.0)

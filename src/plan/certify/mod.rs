@@ -84,7 +84,7 @@ pub(super) fn vehicle_margin<const N: usize>(vehicle: &Vehicle<N>, u: &Uncertain
     // One sample's climb at the pitch limit (module docs): where the
     // vehicle's motion is uncertain, a world between the samples switches
     // at a waypoint up to a sample apart from them.
-    let moves = u.vertical_current() > 0.0 || sin_alpha > 0.0 || u.speed() > 0.0;
+    let moves = u.motion_uncertain();
     let step = u0 * (1.0 + u.speed()) * vehicle.sample_time();
     let jitter = if moves {
         step * sin_pitch / cos_pitch.max(0.01)
@@ -374,7 +374,8 @@ impl<const N: usize> Tube<N> {
 /// flight fails). Each track's altitude less `margin` also lowers the
 /// matching entry of `per_track` (which may be shorter, or empty).
 ///
-/// With nothing declared (the nominal world alone), where a track's end
+/// With one vehicle world (nothing declared, or only the map: each world
+/// then switches where the nominal flight does), where a track's end
 /// lies on its waypoint's knife edge ([`Scenario::on_edge`]), the line is
 /// also flown with that switch the other way ([`fly_once`]'s branch, one
 /// flight more each) while `flights` is below `cap` (else the nominal
@@ -382,6 +383,7 @@ impl<const N: usize> Tube<N> {
 /// arithmetic may switch the other way, and the next track's least
 /// altitude can move by a tenth of a metre (`check_planner.py --seed
 /// 2585`, `unseen_2585_5`: 60.09 m in f32, 59.974 m in f64, below `h_a`).
+/// Under declared motion the vehicle margin's floor covers it instead.
 /// (Not inlined: its callers share one copy of the flight. A branch flies
 /// from the world's start again, after the first flight rather than
 /// inside it, so that a certificate's stack holds one flight at a time.)
@@ -404,7 +406,7 @@ pub(super) fn fly_world<const N: usize>(
     else {
         return FAILED;
     };
-    let edges = if sc.mission().uncertainty().is_none() {
+    let edges = if !sc.mission().uncertainty().motion_uncertain() {
         edges
     } else {
         0
