@@ -52,8 +52,10 @@
 //! decrease into the safe set; if it does, BFGS optimizes from there. When
 //! no scanned depth is safe the track's candidate is the safest scanned
 //! depth. Otherwise BFGS (without a penalty) optimizes from the scan's
-//! parabola vertex, and an unsafe optimum falls back to the boundary by
-//! the same search.
+//! parabola vertex (from the best scanned depth where a neighbour of it
+//! lies on a plateau: a parabola through a plateau's point models
+//! nothing), and an unsafe optimum falls back to the boundary by the same
+//! search.
 //!
 //! **Constraint, a horizon, under BFGS: SQP.** Each track is cut into
 //! segments of about 100 m (`sim/watch.rs`); each segment's least altitude,

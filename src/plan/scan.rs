@@ -192,7 +192,7 @@ fn vertex(s: &Scanned, i: usize, lo: f32, hi: f32, n: u32, single: bool) -> (f32
             .get(m..=i.saturating_add(1))
             .is_some_and(|w| w.iter().all(|k| !k))
     });
-    if !smooth {
+    if !smooth || beside_plateau(s, i, n) {
         // Keep the scanned depth; the first-step scaling sets A_0.
         return (z_best, 0.0);
     }
@@ -216,6 +216,29 @@ fn vertex(s: &Scanned, i: usize, lo: f32, hi: f32, n: u32, single: bool) -> (f32
         }
     }
     (z_best, 0.0)
+}
+
+/// Whether a neighbour of the best scanned point `i` lies on a plateau:
+/// its objective that of the next point out to within a millionth (the
+/// pitch reference saturated over the whole track: the same flight, model
+/// contract §10). A parabola through a plateau's point models nothing; its
+/// vertex can land on the plateau's edge, where `J`'s gradient is next to
+/// nothing, and BFGS then crawls out of it (`check_planner.py --seed 2622
+/// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2622_6`, track 1
+/// unconstrained: the vertex 27.5 m from the best scanned depth toward the
+/// plateau, `J` 5.6 % above it there, 11 iterations to the optimum).
+fn beside_plateau(s: &Scanned, i: usize, n: u32) -> bool {
+    let flat = |a: usize, b: usize| match (s.phis.get(a), s.phis.get(b)) {
+        (Some(&pa), Some(&pb)) if a < n as usize && b < n as usize => {
+            pa.is_finite() && libm::fabsf(pa - pb) <= 1e-6 * libm::fabsf(pa)
+        }
+        _ => false,
+    };
+    let left = i
+        .checked_sub(2)
+        .is_some_and(|o| flat(o.saturating_add(1), o));
+    let right = flat(i.saturating_add(1), i.saturating_add(2));
+    left || right
 }
 
 /// What the scan of a horizon needs to know.
@@ -435,4 +458,50 @@ fn beam_scan<const N: usize, const K: usize>(
         *z0 = best.z;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scan of `phis` over `[0, 80]` m (9 points, 10 m apart).
+    fn scanned(phis: [f32; 9]) -> Scanned {
+        let mut s = Scanned {
+            phis: [f32::INFINITY; MAX_SCAN as usize],
+            kinked: [true; MAX_SCAN as usize],
+        };
+        for (k, p) in phis.into_iter().enumerate() {
+            s.phis[k] = p;
+            s.kinked[k] = false;
+        }
+        s
+    }
+
+    /// The parabola's vertex starts the optimizer, but not where a
+    /// neighbour of the best scanned depth lies on a plateau (its value
+    /// that of the next point out): the best scanned depth does, with the
+    /// measured first step.
+    #[test]
+    fn a_neighbour_on_a_plateau_keeps_the_best_scanned_depth() {
+        // J of the shape of unseen_2622_6's track 1: flat to the left.
+        let flat = [9.0, 9.0, 9.0, 9.0, 9.0, 8.0, 30.0, 60.0, 90.0];
+        assert_eq!(vertex(&scanned(flat), 5, 0.0, 80.0, 9, true), (50.0, 0.0));
+        // The same, mirrored.
+        let mut mirrored = flat;
+        mirrored.reverse();
+        assert_eq!(
+            vertex(&scanned(mirrored), 3, 0.0, 80.0, 9, true),
+            (30.0, 0.0)
+        );
+        // A slope to the left instead of a plateau: the parabola's vertex
+        // (4.57 m left of the best) and its curvature.
+        let sloped = [13.0, 12.0, 11.0, 10.0, 9.0, 8.0, 30.0, 60.0, 90.0];
+        let (z, c) = vertex(&scanned(sloped), 5, 0.0, 80.0, 9, true);
+        let second = 30.0 - 2.0 * 8.0 + 9.0;
+        assert!(
+            (z - (50.0 - 5.0 * (30.0 - 9.0) / second)).abs() < 1e-4,
+            "{z}"
+        );
+        assert!((c - second / 100.0).abs() < 1e-6, "{c}");
+    }
 }
