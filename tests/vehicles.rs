@@ -102,6 +102,18 @@ fn a_basin_past_a_bump_is_looked_for_wider() {
     track_within("far_basin", &UNCONSTRAINED, &premise, 4, 4.273_58e5);
 }
 
+/// A basin between the wider and the widest looks (`check_planner.py
+/// --seed 2649 --vehicle tools/reference/vehicles/rate.toml`,
+/// `unseen_2649_5`, track 2, unconstrained): BFGS ended at 627.975 m, `J`
+/// 478 702 m³, a bump 2 m deeper (480 355 m³ at 630 m) and the basin at
+/// 632.9 m, between the polish's looks at 2 and 8 m (8 m deeper, 481 764
+/// m³, is past it): 1.0059× the f64 best 475 915 m³ (632.900 m, from the
+/// tool's track 1). A look at 4 m finds it.
+#[test]
+fn a_basin_between_the_wider_and_the_widest_looks_is_found() {
+    track_within("polish_gap", &UNCONSTRAINED, &[(0, 500.085)], 1, 475_915.0);
+}
+
 /// A concave stretch (`check_planner.py --seed 1404 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_1404_5`, track 2): `J`
 /// fell at least linearly along each step, the curvature guard skipped
