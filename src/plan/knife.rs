@@ -27,15 +27,16 @@
 //! dive through the waypoint), the depth is kept, and the edge stays: on
 //! `check_planner.py --seed 1801`, `unseen_1801_6` (horizon), track 4's
 //! climb reaches waypoint 4 0.1 mm past it whatever its depth, and track
-//! 5's `J` differs from the f64 re-simulation's by 2.1e-3. The move is
-//! made under declared uncertainty too, shallower only: the declared
-//! worlds then certify the moved depth, which costs no more than the
-//! candidate's own certificate, but a deeper move can lower a certificate
-//! that held by centimetres, and the call then searches
+//! 5's `J` differs from the f64 re-simulation's by 2.1e-3.
+//!
+//! The move is made under declared uncertainty too, shallower only: the
+//! declared worlds then certify the moved depth, which costs no more than
+//! the candidate's own certificate, but a deeper move can lower a
+//! certificate that held by centimetres, and the call then searches
 //! (`check_certified.py --seed 2463`, `synthetic_023`: 265 flights for
-//! the line became 562). Under declared motion the worlds switch at their own
-//! samples and the vehicle margin covers the switch, but the nominal
-//! `min_altitude` reported after the edge is the one arithmetic's:
+//! the line became 562). Under declared motion the worlds switch at their
+//! own samples and the vehicle margin covers the switch, but the nominal
+//! `min_altitude` reported after the edge is one arithmetic's:
 //! `check_certified.py --seed 2451`, `synthetic_034` (horizon, `ε_U` and
 //! `e_v` declared), track 1 committed on the edge, and tracks 2–5's
 //! reported altitudes were 5–6 cm off an f64 re-flight's; moved 2.2 cm
