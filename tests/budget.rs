@@ -19,9 +19,8 @@ mod common;
 use auvnav::{
     Measurement, Mission, PlanError, Planner, PlannerConfig, Profile, Resumable, Scenario, Step,
     TrackScore, TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints,
-    lower_envelope,
 };
-use common::{csv_column, real_profile, real_waypoints};
+use common::{csv_column, real_profile, real_waypoints, with_declared};
 
 const LINES: [(&str, f32, f32); 6] = [
     ("us_monterey_canyon_1", 80.0, 60.0),
@@ -40,25 +39,16 @@ fn line(name: &str) -> (Profile<4096>, Waypoints<16>) {
 }
 
 /// `f` on line `name` (`h_r`, `h_a`, m) under the declared uncertainty
-/// `u`, certified over its lower envelope. (A closure: the scenario
-/// borrows the map and the envelope made here.)
+/// `u`, certified over its lower envelope ([`with_declared`]).
 fn declared<R>(
     vehicle: &Vehicle<3>,
     name: &str,
-    (h_r, h_a): (f32, f32),
+    alt: (f32, f32),
     u: Uncertainty,
     f: impl FnOnce(&Scenario<'_, 3>) -> R,
 ) -> R {
     let (map, wps) = line(name);
-    let env = lower_envelope::<12288>(map.view(), &u, wps.positions()[0]).unwrap();
-    let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
-        .unwrap()
-        .with_uncertainty(u);
-    let sc = Scenario::new(vehicle, &map, &wps, mission)
-        .unwrap()
-        .with_certification_bottom(env.view())
-        .unwrap();
-    f(&sc)
+    with_declared(vehicle, (&map, &wps), alt, u, f)
 }
 
 /// Every track the unbudgeted run (`free`) flies safe is safe in `safe`.

@@ -16,9 +16,8 @@ mod tool;
 use auvnav::{
     Mission, Mode, PidGains, Plan, Planner, PlannerConfig, Profile, Scenario, TrackScore,
     TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints, World,
-    lower_envelope,
 };
-use common::{csv_column, real_profile, real_waypoints};
+use common::{csv_column, real_profile, real_waypoints, with_declared};
 
 struct Lcg(u64);
 impl Lcg {
@@ -184,31 +183,24 @@ fn every_track_reported_safe_is_safe_in_sampled_worlds() {
             let (x, b) = real_profile(name);
             let map = Profile::<4096>::new(&x, &b).unwrap();
             let wps = Waypoints::<16>::new(&real_waypoints(name)).unwrap();
-            let x0 = wps.positions()[0];
-            let env = lower_envelope::<12288>(map.view(), &u, x0).unwrap();
-            let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
-                .unwrap()
-                .with_uncertainty(u);
-            let sc = Scenario::new(&vehicle, &map, &wps, mission)
-                .unwrap()
-                .with_certification_bottom(env.view())
-                .unwrap();
-            let start = sc.start_state(sc.default_initial_depth());
-            let mut planner = Planner::<8>::new(PlannerConfig::default()).unwrap();
-            let plans = plan_line(&mut planner, &sc, &start);
-            let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
-            let safe: Vec<bool> = plans.iter().map(|p| p.safe).collect();
-            if depths.len() < wps.tracks() {
-                continue;
-            }
-            let name = format!("{name} draw {draw}");
-            worlds_flown += sampled_worlds_keep_safe_tracks(
-                (&sc, &map, &u),
-                (&start, &depths, &safe),
-                &mut rng,
-                &name,
-            );
-            safe_tracks += safe.iter().filter(|&&s| s).count();
+            with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
+                let start = sc.start_state(sc.default_initial_depth());
+                let mut planner = Planner::<8>::new(PlannerConfig::default()).unwrap();
+                let plans = plan_line(&mut planner, sc, &start);
+                let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
+                let safe: Vec<bool> = plans.iter().map(|p| p.safe).collect();
+                if depths.len() < wps.tracks() {
+                    return;
+                }
+                let name = format!("{name} draw {draw}");
+                worlds_flown += sampled_worlds_keep_safe_tracks(
+                    (sc, &map, &u),
+                    (&start, &depths, &safe),
+                    &mut rng,
+                    &name,
+                );
+                safe_tracks += safe.iter().filter(|&&s| s).count();
+            });
         }
     }
     println!(
@@ -375,49 +367,44 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
     let map = Profile::<4096>::new(&x, &b).unwrap();
     let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
     let x0 = wps.positions()[0];
-    let env = lower_envelope::<12288>(map.view(), &u, x0).unwrap();
-    let mission = Mission::new(65.95, 33.03, [0.0, 6000.0])
-        .unwrap()
-        .with_uncertainty(u);
-    let sc = Scenario::new(&vehicle, &map, &wps, mission)
-        .unwrap()
-        .with_certification_bottom(env.view())
-        .unwrap();
-    let start = sc.start_state(1065.47);
     let mut rng = Lcg(0x2431_0ff5);
     let shifted: Vec<Profile<8192>> = [1.0, -1.0]
         .iter()
         .map(|&s| world_bottom(&map, &u, x0, &mut rng, Some((s, 0.0))))
         .collect();
-    let mut checked = 0;
-    for mode in [Mode::TrackWise, Mode::Horizon] {
-        let cfg = PlannerConfig {
-            mode,
-            ..PlannerConfig::default()
-        };
-        let mut planner = Planner::<5>::new(cfg).unwrap();
-        let plans = plan_line(&mut planner, &sc, &start);
-        let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
-        let certified: Vec<f32> = plans.iter().map(|p| p.certified_min_altitude).collect();
-        for k in 0..=80 {
-            let world = World {
-                speed: vehicle.speed(),
-                flight_path_offset: alpha_max * (k as f32 / 40.0 - 1.0),
-                vertical_current: 0.0,
+    let checked = with_declared(&vehicle, (&map, &wps), (65.95, 33.03), u, |sc| {
+        let start = sc.start_state(1065.47);
+        let mut checked = 0;
+        for mode in [Mode::TrackWise, Mode::Horizon] {
+            let cfg = PlannerConfig {
+                mode,
+                ..PlannerConfig::default()
             };
-            for bottom in &shifted {
-                let least = fly(&sc, &world, bottom, &start, &depths);
-                for (t, (&h, &c)) in least.iter().zip(&certified).enumerate() {
-                    assert!(
-                        c <= h + 1e-3,
-                        "{mode:?} track {}: certified {c} m, flies {h} m at α = {}°",
-                        t + 1,
-                        world.flight_path_offset
-                    );
-                    checked += 1;
+            let mut planner = Planner::<5>::new(cfg).unwrap();
+            let plans = plan_line(&mut planner, sc, &start);
+            let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
+            let certified: Vec<f32> = plans.iter().map(|p| p.certified_min_altitude).collect();
+            for k in 0..=80 {
+                let world = World {
+                    speed: vehicle.speed(),
+                    flight_path_offset: alpha_max * (k as f32 / 40.0 - 1.0),
+                    vertical_current: 0.0,
+                };
+                for bottom in &shifted {
+                    let least = fly(sc, &world, bottom, &start, &depths);
+                    for (t, (&h, &c)) in least.iter().zip(&certified).enumerate() {
+                        assert!(
+                            c <= h + 1e-3,
+                            "{mode:?} track {}: certified {c} m, flies {h} m at α = {}°",
+                            t + 1,
+                            world.flight_path_offset
+                        );
+                        checked += 1;
+                    }
                 }
             }
         }
-    }
+        checked
+    });
     assert!(checked > 600, "{checked}");
 }

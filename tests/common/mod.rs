@@ -11,7 +11,8 @@
 #![allow(clippy::arithmetic_side_effects)]
 
 use auvnav::{
-    AutopilotConfig, Mission, PidGains, Profile, TfKind, TransferFunction, Vehicle, VehicleConfig,
+    AutopilotConfig, Mission, PidGains, Profile, Scenario, TfKind, TransferFunction, Uncertainty,
+    Vehicle, VehicleConfig, Waypoints, lower_envelope,
 };
 use serde_json::Value;
 
@@ -123,4 +124,26 @@ pub fn profile(v: &Value) -> Profile<S> {
 /// `|got - want| <= rel * |want|`, with the pair in the message.
 pub fn rel_err(got: f64, want: f64) -> f64 {
     (got - want).abs() / want.abs().max(f64::MIN_POSITIVE)
+}
+
+/// `f` on the line `map`, `wps` (`h_r`, `h_a`, m; depth limits 0–6000 m)
+/// under the declared uncertainty `u`, certified over the map's lower
+/// envelope from the line's start. (A closure: the scenario borrows the
+/// envelope made here.)
+pub fn with_declared<R>(
+    vehicle: &Vehicle<3>,
+    (map, wps): (&Profile<S>, &Waypoints<W>),
+    (h_r, h_a): (f32, f32),
+    u: Uncertainty,
+    f: impl FnOnce(&Scenario<'_, 3>) -> R,
+) -> R {
+    let env = lower_envelope::<{ 3 * S }>(map.view(), &u, wps.positions()[0]).unwrap();
+    let mission = Mission::new(h_r, h_a, [0.0, 6000.0])
+        .unwrap()
+        .with_uncertainty(u);
+    let sc = Scenario::new(vehicle, map, wps, mission)
+        .unwrap()
+        .with_certification_bottom(env.view())
+        .unwrap();
+    f(&sc)
 }
