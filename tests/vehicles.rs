@@ -114,6 +114,20 @@ fn a_basin_between_the_wider_and_the_widest_looks_is_found() {
     track_within("polish_gap", &UNCONSTRAINED, &[(0, 500.085)], 1, 475_915.0);
 }
 
+/// A sawtooth whose trend falls into the safe set's boundary
+/// (`check_planner.py --seed 2669 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2669_0`, track 1,
+/// constrained): BFGS ended on a tooth at 624.51 m, and the polish's
+/// doubling steps went to 626.01 m, where the next (628.01 m) flew below
+/// `h_a`: 626.01 m, `J` 29 531 m³, 1.0185× the f64 best safe 28 993.8 m³
+/// at the boundary (627.440 m). The polish now searches the boundary
+/// between its lowest point and the step that left the safe set.
+#[test]
+fn a_sawtooth_falling_into_the_boundary_is_polished_to_it() {
+    let t = track_within("polish_boundary", &["--mode", "track"], &[], 0, 28_993.8);
+    assert_eq!(t["safe"], true);
+}
+
 /// A concave stretch (`check_planner.py --seed 1404 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_1404_5`, track 2): `J`
 /// fell at least linearly along each step, the curvature guard skipped

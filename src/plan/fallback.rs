@@ -2,6 +2,7 @@
 //! scanned depths, then on the safe-set boundary by a root search), or,
 //! when no depth in the box is safe, the safest one found.
 
+use crate::model::Mission;
 use crate::optim::root::{self, RootTol};
 use crate::sim::{TrackScore, VehicleState};
 
@@ -36,12 +37,24 @@ pub(super) struct Boundary<const N: usize> {
     pub inner: Option<(f32, f32)>,
 }
 
+/// The stopping rule of every search of a safe-set boundary in depth, in
+/// at most `steps` flights, for mission `m`. The altitude tolerance: `J`
+/// changes by about `2 δz / (h_r − h_a)` relatively when the boundary
+/// moves by `δz`, so 0.2 % of the envelope keeps that under 0.4 %; at
+/// most `BOUNDARY_ALTITUDE`, at least a millimetre.
+pub(super) fn boundary_rule(m: &Mission, steps: u32) -> RootTol {
+    RootTol {
+        tol: (BOUNDARY_SHARE * (m.reference_altitude() - m.min_altitude()))
+            .clamp(BOUNDARY_DEPTH, BOUNDARY_ALTITUDE),
+        width: BOUNDARY_DEPTH,
+        steps,
+    }
+}
+
 /// The safe-set boundary between a safe depth `good` and an unsafe one
 /// `bad` (each with its minimum altitude when known), from the safe side:
-/// [`crate::optim::root`] on `g(z) = min altitude − h_safe`. The altitude
-/// tolerance: `J` changes by about `2 δz / (h_r − h_a)` relatively when the
-/// boundary moves by `δz`, so 0.2 % of the envelope keeps that under
-/// 0.4 %; at most `BOUNDARY_ALTITUDE`, at least a millimetre.
+/// [`crate::optim::root`] on `g(z) = min altitude − h_safe`, stopped by
+/// [`boundary_rule`].
 pub(super) fn boundary<const N: usize>(
     fl: &mut Flights<'_, '_, N>,
     good: (f32, Option<f32>),
@@ -49,13 +62,7 @@ pub(super) fn boundary<const N: usize>(
     h_safe: f32,
     steps: u32,
 ) -> Result<Boundary<N>, PlanError> {
-    let m = fl.sc.mission();
-    let rule = RootTol {
-        tol: (BOUNDARY_SHARE * (m.reference_altitude() - m.min_altitude()))
-            .clamp(BOUNDARY_DEPTH, BOUNDARY_ALTITUDE),
-        width: BOUNDARY_DEPTH,
-        steps,
-    };
+    let rule = boundary_rule(fl.sc.mission(), steps);
     let margin = |a: Option<f32>| a.map(|a| a - h_safe);
     let r = root::safe_boundary(
         (good.0, margin(good.1)),

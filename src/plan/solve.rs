@@ -7,11 +7,12 @@
 //! certified boundary.
 
 use crate::model::Mission;
-use crate::optim::root::{self, RootTol};
+use crate::optim::root;
 use crate::optim::sqp::{SqpEnd, sqp_into};
 use crate::optim::{self, BfgsConfig, Bounds, GdConfig, OptimError};
 use crate::sim::{SimError, TrackScore};
 
+use super::fallback::boundary_rule;
 use super::objective::{PlanObjective, Stop};
 use super::scan::grid;
 use super::{Method, PlanError, Planner, PlannerConfig};
@@ -35,15 +36,6 @@ pub(super) const RESTORE_SHARE: f32 = 0.1;
 
 /// Factor on `μ` between penalty stages.
 const PENALTY_GROWTH: f32 = 100.0;
-
-/// The committed track's boundary search stops when the horizon's least
-/// altitude is within this share of `h_r − h_a` of the certified altitude
-/// (as the single track's, `fallback.rs`), ...
-const BOUNDARY_SHARE: f32 = 0.002;
-/// ... clamped to this range, m ...
-const BOUNDARY_ALTITUDE: [f32; 2] = [1e-3, 0.02];
-/// ... or when its bracket is this narrow, m.
-const BOUNDARY_DEPTH: f32 = 1e-3;
 
 /// Share of the penalty margin `m_p` above `h_a` that the later tracks of
 /// the horizon keep when the committed depth moves (or what they had, if
@@ -439,8 +431,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let m = *obj.sc.mission();
         let h_safe = m.min_altitude() + self.cfg.safety_margin;
         let band = obj.sc.penalty_altitude() + self.cfg.penalty_margin;
-        let tol = (BOUNDARY_SHARE * (m.reference_altitude() - m.min_altitude()))
-            .clamp(BOUNDARY_ALTITUDE[0], BOUNDARY_ALTITUDE[1]);
+        let rule = boundary_rule(&m, self.cfg.bisection_steps);
+        let tol = rule.tol;
         let base = self.work.z;
         let Ok((j0, first, later)) = horizon_flight(obj, &base) else {
             return;
@@ -456,11 +448,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // the headroom deeper is past the boundary unless the flight there
         // is held by something else (then that depth itself is tried).
         let bad = (z0 + 2.0 * (first - h_safe) + tol).min(hi);
-        let rule = RootTol {
-            tol,
-            width: BOUNDARY_DEPTH,
-            steps: self.cfg.bisection_steps,
-        };
         let good = (z0, Some(margin(first, later)));
         let found = root::safe_boundary(good, (bad, None), rule, |t| {
             let mut z = base;
