@@ -462,6 +462,19 @@ fn tracks_held_above_one_and_a_half_h_r_start_a_wider_beam() {
     horizon_within("held_rate", 1.01, 5.140_149e6);
 }
 
+/// A held track's restart that ends a little short (`check_planner.py
+/// --seed 2701 --vehicle tools/reference/vehicles/rate.toml`,
+/// `unseen_2701_2`): the cold SQP ended feasible with track 2 129 m above
+/// its bottom at its lowest (`h_r` 80 m); the four-path beam's restart
+/// ended at 9.84e6 m³, half the kept end's `J`, with track 3 11 cm below
+/// `h_a` (0.19 m short summed), and was dropped: 2.07× the f64 beam
+/// search's best safe plan (9.491 657e6 m³). Its end repaired (track 3
+/// raised by its shortfall), the restart runs once more from there.
+#[test]
+fn a_restart_that_ends_a_little_short_is_repaired() {
+    horizon_within("held_short", 1.01, 9.491_657e6);
+}
+
 /// The held edge's restart made again as a careful run (`check_planner.py
 /// --seed 2308 --vehicle tools/reference/vehicles/low.toml`,
 /// `unseen_2308_0`): from the start just off track 4's plateau the plain

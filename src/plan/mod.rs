@@ -154,6 +154,7 @@ mod objective;
 mod planner;
 mod plateau;
 mod polish;
+mod restart;
 mod resumable;
 mod scan;
 mod search;
