@@ -462,6 +462,19 @@ fn tracks_held_above_one_and_a_half_h_r_start_a_wider_beam() {
     horizon_within("held_rate", 1.01, 5.140_149e6);
 }
 
+/// A feasible cold SQP end whose first depth has no gradient
+/// (`check_planner.py --seed 2638 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2638_7`): track 1 dives
+/// saturated at 768.7 m from the scan, and no SQP iteration moved it; the
+/// best safe plan flies it at 697 m, 1.9 % higher on its own, so that
+/// track 2 can dive to 975 m (746 m): the line 1.78× the f64 beam
+/// search's best safe plan (2.199 663e6 m³). The four-path beam's restart
+/// now runs there too.
+#[test]
+fn a_first_depth_without_gradient_starts_a_wider_beam() {
+    horizon_within("flat_first", 1.01, 2.199_663e6);
+}
+
 /// A held track's restart that ends a little short (`check_planner.py
 /// --seed 2701 --vehicle tools/reference/vehicles/rate.toml`,
 /// `unseen_2701_2`): the cold SQP ended feasible with track 2 129 m above

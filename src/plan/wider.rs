@@ -50,8 +50,20 @@
 //! the lift and the held edge, which run again from it where it is kept
 //! ([`Planner::cold_escapes`]).
 //!
+//! The same restart runs where a feasible end's first depth has no
+//! gradient at all (a saturated dive or climb through its whole track):
+//! the SQP cannot move it, and the plateau escape (`jump.rs`) moves it
+//! with the later depths held. On `check_planner.py --seed 2638 --vehicle
+//! tools/reference/vehicles/integ.toml` (`unseen_2638_7`) track 1 kept
+//! the scan's 768.7 m through every iteration, where the best safe plan
+//! flies it at 697 m (1.9 % higher on its own) so that track 2 can dive
+//! 229 m deeper: 1.78× the f64 search's best safe `J`; restarted,
+//! 0.996×. On the 267 random lines it runs on 13 more lines and moves
+//! none, for 7.4 flights a line (2 % of the horizon mode's); the 18
+//! shared runs keep their plans and flights.
+//!
 //! Where the end is infeasible the beam keeps [`BEAM_WIDE`] paths, where
-//! it has a held track [`BEAM_HELD`]. On
+//! it has a held track or a first depth without gradient [`BEAM_HELD`]. On
 //! `check_planner.py --seed 2324 --vehicle
 //! tools/reference/vehicles/integ.toml` (`unseen_2324_6`) the cold SQP
 //! ended 13.9 m short summed, under the band, with tracks 2 and 3 held
@@ -81,8 +93,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// the SQP ended infeasible by more than the band; then, without
     /// declared uncertainty, the lift (`lift.rs`) and the held edge
     /// (`jump.rs`, `held_last`); then the wide beam where a track of that
-    /// end is held far above its bottom, and where that restart is kept,
-    /// the lift and the held edge again from it; then the first depth's
+    /// end is held far above its bottom or its first depth has no
+    /// gradient, and where that restart is kept, the lift and the held
+    /// edge again from it; then the first depth's
     /// stride (`stride.rs`); last, where those took the horizon's `J`
     /// below [`AGAIN`] of where the lift first ran, the lift and the held
     /// edge once more (`lift.rs`' module docs). (The held track's restart
@@ -160,7 +173,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `h` tracks in `bounds` (penalty weight `mu` for the scan), feasible
     /// within `tol` (m), `scan` the first track's scanned depths and
     /// `h_safe` the certified altitude (m), after `iterations` so far:
-    /// where the end is infeasible, or (`held`) has a held track. Returns
+    /// where the end is infeasible, or (`held`) has a held track or a
+    /// first depth without gradient. Returns
     /// the iterations so far where the restart is kept. Not inlined: the
     /// scan's state stays off the SQP's stack.
     #[inline(never)]
@@ -183,7 +197,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // held track's: never the same beam twice.)
         let (start, width) = if held {
             let v = obj.last_violation;
-            (v <= tol && self.held_high(obj, h), BEAM_HELD)
+            let flat = self.work.gradient.first() == Some(&0.0);
+            (v <= tol && (flat || self.held_high(obj, h)), BEAM_HELD)
         } else {
             let over = if obj.declared() { band } else { tol };
             (obj.last_violation > over, BEAM_WIDE)
