@@ -122,11 +122,18 @@ impl Search {
             // 0.24 m short (`check_planner.py --seed 2208 --vehicle
             // tools/reference/vehicles/integ.toml`, `unseen_2208_3` track
             // 3, constrained: margin 0.047 m, `J` 1.010× the best safe).
+            // Where those two aim outside the bracket, the unsafe side is
+            // nearly flat and unit steps would crawl along it: bisect, as
+            // below (`check_planner.py --seed 2705 --vehicle
+            // tools/reference/vehicles/low.toml`, `unseen_2705_5` track 1:
+            // 0.57 m steps on a side falling 0.001–0.1 m per m ran out
+            // 1.8 m short, `J` 1.013× the best safe).
             let both_bad = self
                 .latest
                 .is_some_and(|((_, g1), (_, g2))| g1 < 0.0 && g2 < 0.0);
             return match (secant.filter(|_| both_bad), t_unit) {
                 (Some(ts), _) => (ts, false),
+                (None, _) if both_bad => (0.5, false),
                 (None, Some(tu)) if tu > 0.01 && tu < 0.999 => (tu, true),
                 _ => (0.5, false),
             };
@@ -367,6 +374,37 @@ mod tests {
         let r = safe_boundary((838.58, Some(19.998)), (958.49, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!(r.z > 906.4 && (0.0..=0.02).contains(&g), "{} -> {g}", r.z);
+    }
+
+    /// A flat safe side within the tolerance (0.0129 m, from 1 083.2 m),
+    /// the unsafe side falling from 1 086.45 m at 0.26 m per m, then
+    /// ever slower, flat at −0.5622 m beyond 1 092.7 m (`check_planner.py
+    /// --seed 2705 --vehicle tools/reference/vehicles/low.toml`,
+    /// `unseen_2705_5` track 1, constrained; before: the unit steps of the
+    /// deficit, 0.57 m each, crawled from 1 092 m, two unsafe secants
+    /// aimed outside the bracket, and the steps ran out at the safe end
+    /// 1 084.70 m, `J` 1.013× the best safe).
+    #[test]
+    fn bisects_a_nearly_flat_unsafe_side_beyond_a_flat_safe_one() {
+        let f = |z: f32| -> Result<(f32, ()), ()> {
+            let (flat, corner, floor) = (0.012_939, 1086.45, 1092.7);
+            let g = if z <= 1074.82 {
+                0.5119 + 0.2994 * (1074.82 - z)
+            } else if z <= 1083.19 {
+                flat + 0.0596 * (1083.19 - z)
+            } else if z <= corner {
+                flat
+            } else if z <= floor {
+                -0.5622 + 0.5751 * libm::powf((floor - z) / (floor - corner), 2.85)
+            } else {
+                -0.5622
+            };
+            Ok((g, ()))
+        };
+        let r = safe_boundary((1036.46, None), (1343.89, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        // (Within the 16 steps, 0.11 m short of the corner.)
+        assert!(r.z > 1086.3 && (0.0..=0.02).contains(&g), "{} -> {g}", r.z);
     }
 
     #[test]
