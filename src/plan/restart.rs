@@ -77,14 +77,19 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // A restart that ends lower than a feasible kept end but short
             // of its targets: once more from its end repaired.
             let short = restart.is_ok() && kept_v <= tol && v > tol && lower && round == 0;
-            let end = acc.z;
-            // (The edge from where the run went back, before any restore.)
-            let edge = restart
+            let reached = acc.z;
+            // The next round's start: the edge from where the run went
+            // back (before any restore), else the short end repaired.
+            let next = restart
                 .ok()
                 .and_then(|end| end.left)
                 .filter(|_| round == 0)
                 .and_then(|l| self.edge_toward(obj, &l, tol))
-                .or_else(|| short.then(|| repaired(obj, &end, bounds, tol)).flatten());
+                .or_else(|| {
+                    short
+                        .then(|| repaired(obj, &reached, bounds, tol))
+                        .flatten()
+                });
             if better {
                 total = Some(
                     so_far
@@ -95,8 +100,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 obj.last_violation = kept_v;
                 self.work.restore(&kept);
             }
-            let Some(e) = edge else { break };
-            (from, careful) = (e, true);
+            let Some(start) = next else { break };
+            (from, careful) = (start, true);
         }
         total
     }
