@@ -77,7 +77,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // A restart that ends lower than a feasible kept end but short
             // of its targets: once more from its end repaired.
             let short = restart.is_ok() && kept_v <= tol && v > tol && lower && round == 0;
-            let reached = acc.z;
             // The next round's start: the edge from where the run went
             // back (before any restore), else the short end repaired.
             let next = restart
@@ -87,7 +86,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 .and_then(|l| self.edge_toward(obj, &l, tol))
                 .or_else(|| {
                     short
-                        .then(|| repaired(obj, &reached, bounds, tol))
+                        .then(|| repaired(obj, &self.work.z, bounds, tol))
                         .flatten()
                 });
             if better {
@@ -115,7 +114,9 @@ const REPAIRS: u32 = 4;
 /// altitude rises about a metre per metre it is raised, where its own
 /// reference holds it), until the horizon's ℓ1 infeasibility is within
 /// `tol`: the repaired depths, if found within [`REPAIRS`] plain flights
-/// ([`Planner::sqp_restart`]).
+/// ([`Planner::sqp_restart`]). Not inlined: its flight's scores stay off
+/// the restart's frame, which the SQP's sits on.
+#[inline(never)]
 fn repaired<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     z: &[f32; K],
