@@ -26,23 +26,23 @@
 //! tools/reference/vehicles/rate.toml`, `unseen_2560_6` track 5,
 //! unconstrained, BFGS ended in a dip of `J`'s wiggles with a bump 2.5 m
 //! to its deeper side and the basin 5.4 m away (1.0052× the best `J`);
-//! the widest look, 1.0006×. Between the wider and the widest, a look at
-//! twice the wider's step: on `check_planner.py --seed 2649 --vehicle
-//! tools/reference/vehicles/rate.toml`, `unseen_2649_5` track 2,
-//! unconstrained, BFGS ended with a bump 2 m to its deeper side and the
-//! basin 4.9 m away, past the 2 m look and short of the 8 m one (1.0059×
-//! the best `J`); the 4 m look, 1.0012×. On the 267 random lines that look
-//! costs 4.2 more flights a line track by track unconstrained, 1.0
-//! constrained, 1.6 in horizon mode, and moves two lines by 0.1 % of `J`
-//! at most (the 18 shared runs keep their plans). On 267 random lines the
-//! widest look costs 4.2 flights a
-//! line track by track unconstrained, 1.0 constrained, 1.6 in horizon
-//! mode, and moves two lines, each lower (an unconstrained line's `J` by
-//! 9 %, a horizon line's by 0.12 %). On the 256 random lines of the
+//! the widest look, 1.0006×. On 267 random lines the widest look costs
+//! 4.2 flights a line track by track unconstrained, 1.0 constrained, 1.6
+//! in horizon mode, and moves two lines, each lower (an unconstrained
+//! line's `J` by 9 %, a horizon line's by 0.12 %). Between the wider and
+//! the widest, a look at twice the wider's step: on `check_planner.py
+//! --seed 2649 --vehicle tools/reference/vehicles/rate.toml`,
+//! `unseen_2649_5` track 2, unconstrained, BFGS ended with a bump 2 m to
+//! its deeper side and the basin 4.9 m away, past the 2 m look and short
+//! of the 8 m one (1.0059× the best `J`); the 4 m look, 1.0012×. On the
+//! 267 random lines that look costs about as much again (measured without
+//! it: 4.2 flights a line track by track unconstrained, 1.0 constrained,
+//! 1.6 in horizon mode), and moves two lines by 0.1 % of `J` at most (the
+//! 18 shared runs keep their plans). On the 256 random lines of the
 //! earlier rounds the first two looks cost 4.2 flights a line track by
 //! track unconstrained, 0.9 constrained, 1.0 in horizon mode, and moved
-//! four lines, each lower (by 0.07 % at most). Only where the
-//! optimizer's end looks like a tooth or a step:
+//! four lines, each lower (by 0.07 % at most). Only where the optimizer's
+//! end looks like a tooth or a step:
 //! its gradient would move `J` over [`STEP`] by more than [`SHARE`] of `J`
 //! (at a smooth optimum the gradient vanishes), or `J` still fell by more
 //! than that share in the optimizer's last iteration (a staircase, whose
