@@ -427,27 +427,16 @@ impl<const N: usize> Lift<N> {
         Ok(with_depth(&z, self.g, d))
     }
 
-    /// The point of `(clear, held)` nearest `held` at which track `g`
-    /// clears its target, found by [`NARROW`] bisections (one flight of
-    /// the two tracks each), with depth `k` of `z` at `depth(t)` (m) for
-    /// each point `t` tried.
+    /// [`clearing`] for track `g` from the state track `j` starts in.
     fn clearing<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         z: &[f32; K],
-        (k, depth): (usize, impl Fn(f32) -> f32),
-        (mut clear, mut held): (f32, f32),
+        moved: (usize, impl Fn(f32) -> f32),
+        ends: (f32, f32),
     ) -> Result<f32, Stop> {
-        for _ in 0..NARROW {
-            let mid = 0.5 * (clear + held);
-            let at = with_depth(z, k, depth(mid));
-            if obj.least_at((&self.at_j, self.j), &at, self.g)? >= self.target {
-                clear = mid;
-            } else {
-                held = mid;
-            }
-        }
-        Ok(clear)
+        let from = (&self.at_j, self.j);
+        clearing(obj, from, (self.g, self.target), (z, moved), ends)
     }
 
     /// Track `g` at its deepest useful depth (its deepest bottom less
@@ -492,41 +481,16 @@ impl<const N: usize> Lift<N> {
         let (Some(z), Some(lo)) = (start, lo) else {
             return Ok(start);
         };
-        let Some(&zk) = z.get(k).filter(|_| k < obj.count) else {
+        if k >= obj.count || z.get(k).is_none() {
             return Ok(start);
-        };
+        }
         let target = obj.target_of(k);
-        let least = |obj: &mut PlanObjective<'_, N>, d: f32| {
-            obj.least_at((&self.at_j, self.j), &with_depth(&z, k, d), k)
-        };
-        if least(obj, zk)? >= target - self.band {
+        let from = (&self.at_j, self.j);
+        if obj.least_at(from, &z, k)? >= target - self.band {
             return Ok(start);
         }
-        let clears = |obj: &mut PlanObjective<'_, N>, d: f32| least(obj, d).map(|a| a >= target);
-        let (mut held, mut step) = (zk, self.band);
-        let mut clear = None;
-        for _ in 0..LIFTS {
-            let up = crate::num::max(zk - step, lo);
-            if clears(obj, up)? {
-                clear = Some(up);
-                break;
-            }
-            if up <= lo {
-                break;
-            }
-            (held, step) = (up, 2.0 * step);
-        }
-        let Some(clear) = clear else {
-            return Ok(start);
-        };
-        // (The same bisections as `clearing`, on track `g + 1`.)
-        let next = Lift {
-            g: k,
-            target,
-            ..*self
-        };
-        let d = next.clearing(obj, &z, (k, |d| d), (clear, held))?;
-        Ok(Some(with_depth(&z, k, d)))
+        let d = raised(obj, from, (&z, k), (target, self.band, lo))?;
+        Ok(Some(d.map_or(z, |d| with_depth(&z, k, d))))
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
@@ -544,6 +508,59 @@ impl<const N: usize> Lift<N> {
         }
         Ok(with_depth(&z, self.j, self.zj - free))
     }
+}
+
+/// Depth `k` of `z` raised until track `k`, flown with the tracks from
+/// `j` on from `at_j` (the state track `j` starts in), clears `target`
+/// (m): shallower by `band` (m), doubling ([`LIFTS`] times at most, not
+/// above `lo`, m), then [`NARROW`] bisections toward the last depth that
+/// did not clear it; one flight of tracks `j..=k` each. The deepest depth
+/// found that clears it, if any.
+pub(super) fn raised<const N: usize, const K: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    (at_j, j): (&VehicleState<N>, usize),
+    (z, k): (&[f32; K], usize),
+    (target, band, lo): (f32, f32, f32),
+) -> Result<Option<f32>, Stop> {
+    let Some(&zk) = z.get(k) else {
+        return Ok(None);
+    };
+    let (mut held, mut step) = (zk, band);
+    for _ in 0..LIFTS {
+        let up = crate::num::max(zk - step, lo);
+        if obj.least_at((at_j, j), &with_depth(z, k, up), k)? >= target {
+            let d = clearing(obj, (at_j, j), (k, target), (z, (k, |d| d)), (up, held))?;
+            return Ok(Some(d));
+        }
+        if up <= lo {
+            break;
+        }
+        (held, step) = (up, 2.0 * step);
+    }
+    Ok(None)
+}
+
+/// The point of `(clear, held)` nearest `held` at which track `g`, flown
+/// with the tracks from `j` on from `at_j`, clears `target` (m), found by
+/// [`NARROW`] bisections (one flight of tracks `j..=g` each), with depth
+/// `k` of `z` at `depth(t)` (m) for each point `t` tried.
+fn clearing<const N: usize, const K: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    (at_j, j): (&VehicleState<N>, usize),
+    (g, target): (usize, f32),
+    (z, (k, depth)): (&[f32; K], (usize, impl Fn(f32) -> f32)),
+    (mut clear, mut held): (f32, f32),
+) -> Result<f32, Stop> {
+    for _ in 0..NARROW {
+        let mid = 0.5 * (clear + held);
+        let at = with_depth(z, k, depth(mid));
+        if obj.least_at((at_j, j), &at, g)? >= target {
+            clear = mid;
+        } else {
+            held = mid;
+        }
+    }
+    Ok(clear)
 }
 
 /// The bottom depths (m) of the profile's samples on line track `t`;
