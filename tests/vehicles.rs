@@ -757,3 +757,25 @@ fn a_floor_set_by_the_arrival_answers_its_least_j() {
     assert_eq!(t["status"], "constrained", "on the floor: {t}");
     assert_eq!(t["safe"], true, "on the floor: {t}");
 }
+
+/// An earlier track held above the depth its `J` wants by a later track
+/// (`check_planner.py --seed 2676 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_2676_7`): the cold SQP ended
+/// with track 1 at 976.9 m, its least altitude (32.5 m, `h_a` 28 m) set by
+/// the start, held by track 2 at its target; the best safe plan flies
+/// track 1 97 m deeper and track 2 73 m shallower. The line's `J` was
+/// 5.293e6 m³, 1.20× the f64 beam search's best safe plan (4.393 235e6
+/// m³). Track 1 sunk with track 2 raised (`src/plan/sink.rs`), 1.002×.
+#[test]
+fn an_earlier_track_held_above_is_sunk() {
+    horizon_within("sink", 1.01, 4.393_235e6);
+}
+
+/// The same on later tracks (`check_planner.py --seed 2724 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_2724_3`): track 2 held
+/// above by track 3; the line's `J` was 2.254e6 m³, 1.17× the f64 beam
+/// search's best safe plan (1.925 120e6 m³); sunk, 1.0008×.
+#[test]
+fn a_later_track_held_above_is_sunk() {
+    horizon_within("sink_second", 1.01, 1.925_120e6);
+}

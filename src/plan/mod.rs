@@ -159,6 +159,7 @@ mod resumable;
 mod scan;
 mod search;
 mod single;
+mod sink;
 mod solve;
 mod status;
 mod stride;
