@@ -15,17 +15,26 @@
 
 mod tool;
 
+use std::path::Path;
+
 use tool::{fixture, json_of, json_of_fixture, run};
 
 /// Every interior waypoint's nearest sample of the flight, m, in each of
 /// the tool's modes on fixture `knife`.
 fn nearest_samples(mode: &[&str]) -> Vec<f64> {
     let (p, w, c) = fixture("knife");
+    nearest_samples_of((&p, &w, &c), mode)
+}
+
+/// Every interior waypoint's nearest sample of the flight, m, planned on
+/// `(profile, waypoints, config)` with the options `mode`.
+fn nearest_samples_of((p, w, c): (&str, &str, &str), mode: &[&str]) -> Vec<f64> {
     let dir = std::env::temp_dir().join(format!("auvnav-knife-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join(format!("{}.csv", mode.join("_")));
+    let name = Path::new(c).file_stem().unwrap().to_str().unwrap();
+    let out = dir.join(format!("{name}_{}.csv", mode.join("_")));
     let path = out.to_str().unwrap();
-    let mut args = vec!["--profile", &p, "--waypoints", &w, "--config", &c];
+    let mut args = vec!["--profile", p, "--waypoints", w, "--config", c];
     args.extend(mode);
     args.extend(["--trajectory", path]);
     let o = run(&args);
@@ -74,6 +83,27 @@ fn no_committed_track_ends_on_its_waypoints_knife_edge() {
                 i + 1
             );
         }
+    }
+}
+
+/// Under declared motion, a kept continuation whose first track ends
+/// within a millimetre of its waypoint is left for the candidate where
+/// that certifies (`src/plan/knife.rs`). On `check_certified.py --seed
+/// 2537 --bounds-kind motion` (Monterey 1, horizon, `ε_U` 0.00506,
+/// fixture `edge_motion.toml`) call 2 kept a continuation whose sample lay
+/// 0.1 mm past waypoint 2, 7.6 µm short of it in the f64 re-flight: the
+/// next tracks' reported altitudes were 7 cm off the f64 flight's.
+#[test]
+fn under_declared_motion_a_kept_continuation_leaves_the_inner_edge() {
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/data/bathymetry/");
+    let p = format!("{data}us_monterey_canyon_1.csv");
+    let w = format!("{data}us_monterey_canyon_1.waypoints.csv");
+    let (_, _, c) = fixture("edge_motion");
+    let near = nearest_samples_of((&p, &w, &c), &[]);
+    assert_eq!(near.len(), 4);
+    // (The trajectory's positions are f32 printed: 0.1 mm allowed.)
+    for (i, d) in near.iter().enumerate() {
+        assert!(*d >= 0.9e-3, "waypoint {}: a sample {d} m from it", i + 1);
     }
 }
 

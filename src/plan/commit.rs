@@ -28,7 +28,6 @@ use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
 use super::fallback::Flown;
 use super::flights::Flights;
-use super::knife::one_vehicle;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
@@ -93,13 +92,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
         // The previous continuation on its waypoint's knife edge (`knife.rs`),
         // the candidate off it: the candidate's way instead.
-        if chosen.previous
-            && one_vehicle(sc)
-            && sc.on_edge(track, &flown.next)
-            && !sc.on_edge(track, &cand.flown.next)
+        if chosen.previous && sc.on_edge(track, &flown.next) && !sc.on_edge(track, &cand.flown.next)
         {
-            let how = (guaranteed, false);
-            (chosen, flown) = self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
+            let kept = (chosen, flown);
+            (chosen, flown) =
+                self.off_kept_edge((sc, bottom), at, (cand, guaranteed), kept, &mut flights)?;
         }
         let depth = chosen.depths[0];
         let minima = if chosen.previous {
@@ -142,7 +139,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// [`Planner::choose`], with the chosen depth's nominal flight.
-    fn choose_flown(
+    pub(super) fn choose_flown(
         &mut self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
@@ -351,7 +348,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `chosen` with its certificate complete: a partial one (some worlds
     /// left unflown, its altitudes upper bounds) is flown again in every
     /// world, budget permitting (else it is no certificate at all).
-    fn completed(
+    pub(super) fn completed(
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
@@ -368,7 +365,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The candidate continuation's certificate: known (a budgeted
     /// fallback's), its flight's (one track), or flown.
-    fn certify_candidate(
+    pub(super) fn certify_candidate(
         &self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
@@ -552,7 +549,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
 /// The committed depth's flight: the candidate's when the depth is its,
 /// else flown (one more flight in `flights`).
-fn fly_committed<const N: usize>(
+pub(super) fn fly_committed<const N: usize>(
     sc: &Scenario<'_, N>,
     (state, track): (&VehicleState<N>, usize),
     depth: f32,

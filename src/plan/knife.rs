@@ -53,25 +53,45 @@
 //! continuation instead of its candidate (`commit.rs`): where that
 //! continuation's first depth is on the edge and the candidate is not,
 //! the call takes the candidate's way (certifies it, or searches), with
-//! one vehicle world ([`one_vehicle`]) only: under declared motion the
+//! one vehicle world ([`one_vehicle`]). Under declared motion the
 //! candidate's certificate costs a flight of the line per declared world
 //! where the kept continuation's is known, and a failed one a search
-//! (Monterey 1 with the README's declared uncertainty, in round 23: 159
-//! flights against 12), so the continuation is kept on its edge.
+//! (Monterey 1 with the README's declared uncertainty: call 4 kept a
+//! continuation whose sample lies 1.4 mm past waypoint 4, and certifying
+//! the candidate instead took the call from 12 flights to 159). There the
+//! candidate is certified, and no search made, only where the kept
+//! continuation's sample lies within [`INNER`] of the waypoint, half the
+//! edge (the f32 and f64 samples were 0.8 mm apart at most, above), and
+//! committed where it certifies; else the continuation is kept on its
+//! edge. On `check_certified.py --seed 2537 --bounds-kind motion`
+//! (Monterey 1, `b2`: `ε_U` 0.005) call 2 kept a continuation whose
+//! sample lay 0.1 mm past waypoint 2 (7.6 µm short of it in f64), and
+//! tracks 3 and 4's reported altitudes were 7 cm off an f64
+//! re-flight's; the candidate, 1.8 cm shallower, certifies (3 flights
+//! more) and they agree within a millimetre.
 
 use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, World, offset};
 
-use super::Planner;
+use crate::model::ProfileView;
+
 use super::candidate::Candidate;
+use super::certify::ALL;
+use super::commit::{Chosen, fly_committed};
 use super::fallback::Flown;
 use super::flights::Flights;
+use super::planner::MAX_TRACKS;
 use super::scan::search_box;
+use super::{PlanError, Planner};
 
 /// First probe, m of depth.
 const PROBE: f32 = 5e-3;
 
 /// Longest move, m of depth.
 const MOST: f32 = 0.25;
+
+/// Under declared motion, the half-width (m) of the knife edge within
+/// which a kept continuation is left for the candidate (module docs).
+const INNER: f32 = 0.5 * EDGE;
 
 /// Most relative rise of the track's `J` a move may cost.
 const J_SHARE: f32 = 1e-3;
@@ -168,6 +188,65 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         {
             self.tube.branch(World::nominal(sc.vehicle()), &other);
         }
+    }
+
+    /// The commit where the previous call's continuation, kept, ends its
+    /// first track on the waypoint's knife edge and the candidate does
+    /// not: with one vehicle world ([`one_vehicle`]) the candidate's way
+    /// (certified, or the search); under declared motion, where the kept
+    /// continuation's sample lies within [`INNER`] of the waypoint, the
+    /// candidate where it certifies, no search made (module docs); else
+    /// `kept`.
+    pub(super) fn off_kept_edge(
+        &mut self,
+        (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
+        (state, track): (&VehicleState<N>, usize),
+        (cand, guaranteed): (&Candidate<N>, bool),
+        kept: (Chosen<N>, Flown<N>),
+        flights: &mut u32,
+    ) -> Result<(Chosen<N>, Flown<N>), PlanError> {
+        let at = (state, track);
+        if one_vehicle(sc) {
+            let how = (guaranteed, false);
+            return self.choose_flown(sc, bottom, at, (cand, how), flights);
+        }
+        let inner = sc
+            .edge_waypoint(track)
+            .is_some_and(|end| libm::fabsf(offset(&kept.1.next, end)) < INNER);
+        if !inner {
+            return Ok(kept);
+        }
+        match self.certified_off_edge((sc, bottom), at, cand, flights) {
+            Some(c) => {
+                let flown = fly_committed(sc, at, c.depths[0], cand.flown, flights)?;
+                Ok((c, flown))
+            }
+            None => Ok(kept),
+        }
+    }
+
+    /// The candidate continuation where it certifies, no search made.
+    /// Not inlined: its frame stays off the commit's stack.
+    #[inline(never)]
+    fn certified_off_edge(
+        &mut self,
+        (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
+        (state, track): (&VehicleState<N>, usize),
+        cand: &Candidate<N>,
+        flights: &mut u32,
+    ) -> Option<Chosen<N>> {
+        let len = sc.waypoints().tracks().saturating_sub(track);
+        if len > MAX_TRACKS {
+            return None;
+        }
+        self.tube
+            .materialize((sc, bottom), (state, track), (ALL, &mut *flights));
+        let shallow = sc.mission().depth_limits()[0];
+        let horizon = (&self.work.z, self.horizon_len);
+        let c = self.candidate_continuation((track, len), (cand.flown.depth, horizon), shallow);
+        let cert = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
+        let chosen = self.completed(sc, bottom, Chosen::new(c, len, cert), flights);
+        (chosen.cert.all >= cand.h_safe).then_some(chosen)
     }
 
     /// One side's move (`side` −1: shallower, +1: deeper): the probe,
