@@ -29,14 +29,15 @@
 //! a shallower start passes a rise of the bottom higher, so a climb on
 //! track `g − 1` can buy a deep track `g` (`unseen_90317_0`, where the
 //! best plan climbs 209 m on track 3 to fly track 4 250 m deeper). The
-//! least such lift found by doubling is narrowed by [`NARROW`] bisections
-//! (one flight each); where the climb saturates before any lift frees it,
-//! the least lift that reached the saturation is taken. The same search
-//! is made for track `g` at its deepest useful depth (its deepest bottom
-//! less `h_r`) where that is more than the band below the preferred one:
-//! on a track whose bottom falls away, the best plan may dive at the pitch
-//! limit the whole track (a saturated plateau) from a start lifted further
-//! than the mean needs. On `check_planner.py --seed 2203 --vehicle
+//! least such lift found by doubling is narrowed by
+//! [`NARROW`](super::raise::NARROW) bisections (one flight each); where
+//! the climb saturates before any lift frees it, the least lift that
+//! reached the saturation is taken. The same search is made for track
+//! `g` at its deepest useful depth (its deepest bottom less `h_r`) where
+//! that is more than the band below the preferred one: on a track whose
+//! bottom falls away, the best plan may dive at the pitch limit the
+//! whole track (a saturated plateau) from a start lifted further than the
+//! mean needs. On `check_planner.py --seed 2203 --vehicle
 //! tools/reference/vehicles/integ.toml` (`unseen_2203_4`) the preferred
 //! start (track 1 lifted 20 m, track 2 at 816 m) restarted into the SQP's
 //! end again; the deepest (track 1 lifted 90 m, track 2 at 980 m) ends at
@@ -84,8 +85,8 @@
 //! deepest depth, where it leaves track `g + 1` more than the band below
 //! its target (a dive carried on from a deeper arrival), has
 //! depth `g + 1` raised to the deepest found that clears it (doubling,
-//! then [`NARROW`] bisections), since a later depth on a saturated
-//! plateau gives the restart's restoration no gradient: on `--seed 2308`
+//! then [`NARROW`](super::raise::NARROW) bisections), since a later
+//! depth on a saturated plateau gives the restart's restoration no gradient: on `--seed 2308`
 //! (`low`, `unseen_2308_5`) the start left track 3 165 m into the
 //! bottom, and the restart retreated track 2 instead; raised, the line
 //! goes from 1.18× to 0.994× the f64 best. (Raised wherever it is below
@@ -138,6 +139,7 @@ use crate::sim::{Scenario, VehicleState};
 
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
+use super::raise::{clearing, raised};
 use super::scan::with_depth;
 
 /// Lifts tried for one track (the band, doubling).
@@ -151,9 +153,6 @@ const FREED_SHARE: f32 = 0.25;
 /// track still counts as held where the depth loop integrates (module
 /// docs).
 const TEETH_SLACK: f32 = 0.05;
-
-/// Bisections of the least lift that frees a track's preferred depth.
-const NARROW: u32 = 3;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The escape of the module docs over a horizon of `h` tracks in
@@ -467,10 +466,8 @@ impl<const N: usize> Lift<N> {
 
     /// `start` (if any) with track `g + 1`'s depth raised, where the start
     /// leaves that track more than the band below its target, to the
-    /// deepest depth found that clears it: shallower by the band, doubling
-    /// ([`LIFTS`] times at most, not above `lo`, m), then [`NARROW`]
-    /// bisections; one flight of tracks `j..=g + 1` each, and one to see
-    /// whether it is needed.
+    /// deepest depth found that clears it ([`raised`]); one flight of
+    /// tracks `j..=g + 1` each, and one to see whether it is needed.
     fn repaired<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -494,8 +491,8 @@ impl<const N: usize> Lift<N> {
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
-    /// `(held, free]` that frees it, by [`NARROW`] bisections (one flight
-    /// of the two tracks each) where `free > held`.
+    /// `(held, free]` that frees it, by [`NARROW`](super::raise::NARROW)
+    /// bisections (one flight of the two tracks each) where `free > held`.
     fn narrowed<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -508,59 +505,6 @@ impl<const N: usize> Lift<N> {
         }
         Ok(with_depth(&z, self.j, self.zj - free))
     }
-}
-
-/// Depth `k` of `z` raised until track `k`, flown with the tracks from
-/// `j` on from `at_j` (the state track `j` starts in), clears `target`
-/// (m): shallower by `band` (m), doubling ([`LIFTS`] times at most, not
-/// above `lo`, m), then [`NARROW`] bisections toward the last depth that
-/// did not clear it; one flight of tracks `j..=k` each. The deepest depth
-/// found that clears it, if any.
-pub(super) fn raised<const N: usize, const K: usize>(
-    obj: &mut PlanObjective<'_, N>,
-    (at_j, j): (&VehicleState<N>, usize),
-    (z, k): (&[f32; K], usize),
-    (target, band, lo): (f32, f32, f32),
-) -> Result<Option<f32>, Stop> {
-    let Some(&zk) = z.get(k) else {
-        return Ok(None);
-    };
-    let (mut held, mut step) = (zk, band);
-    for _ in 0..LIFTS {
-        let up = crate::num::max(zk - step, lo);
-        if obj.least_at((at_j, j), &with_depth(z, k, up), k)? >= target {
-            let d = clearing(obj, (at_j, j), (k, target), (z, (k, |d| d)), (up, held))?;
-            return Ok(Some(d));
-        }
-        if up <= lo {
-            break;
-        }
-        (held, step) = (up, 2.0 * step);
-    }
-    Ok(None)
-}
-
-/// The point of `(clear, held)` nearest `held` at which track `g`, flown
-/// with the tracks from `j` on from `at_j`, clears `target` (m), found by
-/// [`NARROW`] bisections (one flight of tracks `j..=g` each), with depth
-/// `k` of `z` at `depth(t)` (m) for each point `t` tried.
-fn clearing<const N: usize, const K: usize>(
-    obj: &mut PlanObjective<'_, N>,
-    (at_j, j): (&VehicleState<N>, usize),
-    (g, target): (usize, f32),
-    (z, (k, depth)): (&[f32; K], (usize, impl Fn(f32) -> f32)),
-    (mut clear, mut held): (f32, f32),
-) -> Result<f32, Stop> {
-    for _ in 0..NARROW {
-        let mid = 0.5 * (clear + held);
-        let at = with_depth(z, k, depth(mid));
-        if obj.least_at((at_j, j), &at, g)? >= target {
-            clear = mid;
-        } else {
-            held = mid;
-        }
-    }
-    Ok(clear)
 }
 
 /// The bottom depths (m) of the profile's samples on line track `t`;

@@ -154,6 +154,7 @@ mod objective;
 mod planner;
 mod plateau;
 mod polish;
+mod raise;
 mod restart;
 mod resumable;
 mod scan;

@@ -26,7 +26,7 @@
 //! still clears its own target there (one flight of tracks `j..=g` tells
 //! both). At each sink, depth `g` is raised from where the last sink left
 //! it to the deepest depth found that clears its target
-//! ([`super::lift::raised`]), and the start so made is flown to the end
+//! ([`super::raise::raised`]), and the start so made is flown to the end
 //! of the horizon: the sink whose start has the lowest `J`, below the
 //! SQP's and feasible within the band, restarts the SQP, kept where it
 //! ends better ([`Planner::sqp_restart`]). The sinks stop where a start's
@@ -42,7 +42,7 @@ use crate::optim::Bounds;
 use crate::sim::TrackScore;
 
 use super::Planner;
-use super::lift::raised;
+use super::raise::raised;
 use super::objective::{PlanObjective, Stop};
 use super::scan::with_depth;
 
