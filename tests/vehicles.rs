@@ -779,3 +779,15 @@ fn an_earlier_track_held_above_is_sunk() {
 fn a_later_track_held_above_is_sunk() {
     horizon_within("sink_second", 1.01, 1.925_120e6);
 }
+
+/// A lift past a dive's plateau (`check_planner.py --seed 2730 --vehicle
+/// tools/reference/vehicles/second.toml`, `unseen_2730_4`): lifts of 20
+/// and 40 m left track 4's saturated dive the same, and the search took
+/// it for a saturated climb; the best plan lifts track 4 by 116 m so that
+/// track 5 flies 47 m deeper. The line's `J` was 3.770e6 m³, 1.23× the
+/// f64 beam search's best safe plan (3.059 614e6 m³); lifted on
+/// (`src/plan/lift.rs`), 1.004×.
+#[test]
+fn a_lift_goes_on_past_a_dives_plateau() {
+    horizon_within("lift_dive", 1.01, 3.059_614e6);
+}

@@ -71,6 +71,21 @@
 //! `unseen_1404_5` 0.94×; `unseen_1203_3` 1.021×, still 0.973× the f64
 //! best) at 14 flights a line.
 //!
+//! A lift that leaves track `g` at its deep depth no higher than the last
+//! one ends the search as a saturated climb only where the lifted depth
+//! is at or above the state track `g − 1` starts in. Below it, the track
+//! still dives, and a dive saturated the whole track flies the same
+//! however far its reference is lifted, until the lift brings the
+//! reference within the dive's reach. On `check_planner.py --seed 2730
+//! --vehicle tools/reference/vehicles/second.toml` (`unseen_2730_4`)
+//! lifts of 20 and 40 m left track 4's dive, from 593 m toward 785 m,
+//! the same, and the search stopped; the best plan lifts track 4 by 116
+//! m, so that track 5 flies 47 m deeper. The line's `J` was 1.23× the
+//! f64 search's best safe plan; lifted on past the dive's plateau (80,
+//! then 160 m), 1.004×. On the 267 random lines 16 move (`unseen_3125_1`
+//! −0.4 %, `unseen_3101_1` +0.8 %), 0.9 flights a line fewer; the 18
+//! shared runs keep their plans, Medes 2 at a flight fewer.
+//!
 //! The deepest depth's search doubles the lift until track `g` at that
 //! depth clears its target; a lift that frees track `g` at its own depth
 //! first no longer ends it. On `check_planner.py --seed 2309 --vehicle
@@ -372,7 +387,10 @@ impl<const N: usize> Lift<N> {
                 if a >= self.target {
                     return Ok(Next::Deep((held, self.zj - up)));
                 }
-                if a <= last + self.slack {
+                // (A lifted depth still below track `j`'s start is a dive
+                // cut short, not a climb: module docs.)
+                let climbs = up <= self.at_j.depth();
+                if a <= last + self.slack && climbs {
                     // The climb saturates: no lift frees more. (Past a
                     // freeing lift, kept only within the band of its
                     // target: module docs.)
