@@ -26,8 +26,8 @@ use crate::sim::{Scenario, TrackScore, VehicleState, World};
 
 use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
-use super::fallback::Flown;
-use super::flights::Flights;
+use super::fallback::{Flown, fly_committed};
+use super::knife::one_vehicle;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
@@ -94,9 +94,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // the candidate off it: the candidate's way instead.
         if chosen.previous && sc.on_edge(track, &flown.next) && !sc.on_edge(track, &cand.flown.next)
         {
-            let kept = (chosen, flown);
-            (chosen, flown) =
-                self.off_kept_edge((sc, bottom), at, (cand, guaranteed), kept, &mut flights)?;
+            if one_vehicle(sc) {
+                let how = (guaranteed, false);
+                (chosen, flown) = self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
+            } else if let Some(c) =
+                self.off_kept_edge((sc, bottom), at, (cand, &flown), &mut flights)
+            {
+                flown = fly_committed(sc, at, c.depths[0], cand.flown, &mut flights)?;
+                chosen = c;
+            }
         }
         let depth = chosen.depths[0];
         let minima = if chosen.previous {
@@ -139,7 +145,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     }
 
     /// [`Planner::choose`], with the chosen depth's nominal flight.
-    pub(super) fn choose_flown(
+    fn choose_flown(
         &mut self,
         sc: &Scenario<'_, N>,
         bottom: ProfileView<'_>,
@@ -545,30 +551,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         );
         plan
     }
-}
-
-/// The committed depth's flight: the candidate's when the depth is its,
-/// else flown (one more flight in `flights`).
-pub(super) fn fly_committed<const N: usize>(
-    sc: &Scenario<'_, N>,
-    (state, track): (&VehicleState<N>, usize),
-    depth: f32,
-    candidate: Flown<N>,
-    flights: &mut u32,
-) -> Result<Flown<N>, PlanError> {
-    if depth.to_bits() == candidate.depth.to_bits() {
-        return Ok(candidate);
-    }
-    let mut fl = Flights {
-        sc: *sc,
-        state,
-        track,
-        count: *flights,
-        limit: u32::MAX,
-    };
-    let (score, next) = fl.fly(depth)?;
-    *flights = fl.count;
-    Ok(Flown { depth, score, next })
 }
 
 /// Whether the only world is the nominal one over the map, from `state`:

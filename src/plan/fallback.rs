@@ -4,7 +4,7 @@
 
 use crate::model::Mission;
 use crate::optim::root::{self, RootTol};
-use crate::sim::{TrackScore, VehicleState};
+use crate::sim::{Scenario, TrackScore, VehicleState};
 
 use super::PlanError;
 use super::flights::Flights;
@@ -164,4 +164,28 @@ pub(super) fn fallback<const N: usize>(
             ))
         }
     }
+}
+
+/// The committed depth's flight: the candidate's when the depth is its,
+/// else flown (one more flight in `flights`).
+pub(super) fn fly_committed<const N: usize>(
+    sc: &Scenario<'_, N>,
+    (state, track): (&VehicleState<N>, usize),
+    depth: f32,
+    candidate: Flown<N>,
+    flights: &mut u32,
+) -> Result<Flown<N>, PlanError> {
+    if depth.to_bits() == candidate.depth.to_bits() {
+        return Ok(candidate);
+    }
+    let mut fl = Flights {
+        sc: *sc,
+        state,
+        track,
+        count: *flights,
+        limit: u32::MAX,
+    };
+    let (score, next) = fl.fly(depth)?;
+    *flights = fl.count;
+    Ok(Flown { depth, score, next })
 }

@@ -74,14 +74,14 @@ use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, World, offset};
 
 use crate::model::ProfileView;
 
+use super::Planner;
 use super::candidate::Candidate;
 use super::certify::ALL;
-use super::commit::{Chosen, fly_committed};
+use super::commit::Chosen;
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::MAX_TRACKS;
 use super::scan::search_box;
-use super::{PlanError, Planner};
 
 /// First probe, m of depth.
 const PROBE: f32 = 5e-3;
@@ -190,44 +190,29 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
     }
 
-    /// The commit where the previous call's continuation, kept, ends its
-    /// first track on the waypoint's knife edge and the candidate does
-    /// not: with one vehicle world ([`one_vehicle`]) the candidate's way
-    /// (certified, or the search); under declared motion, where the kept
-    /// continuation's sample lies within [`INNER`] of the waypoint, the
-    /// candidate where it certifies, no search made (module docs); else
-    /// `kept`.
+    /// Under declared motion, where the previous call's continuation,
+    /// kept, ends its first track (`kept`, its nominal flight) within
+    /// [`INNER`] of the waypoint and the candidate does not end on the
+    /// edge: the candidate continuation if it certifies, no search made
+    /// (module docs). Not inlined: its frame stays off the commit's stack.
+    #[inline(never)]
     pub(super) fn off_kept_edge(
         &mut self,
         (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
-        (state, track): (&VehicleState<N>, usize),
-        (cand, guaranteed): (&Candidate<N>, bool),
-        kept: (Chosen<N>, Flown<N>),
+        at: (&VehicleState<N>, usize),
+        (cand, kept): (&Candidate<N>, &Flown<N>),
         flights: &mut u32,
-    ) -> Result<(Chosen<N>, Flown<N>), PlanError> {
-        let at = (state, track);
-        if one_vehicle(sc) {
-            let how = (guaranteed, false);
-            return self.choose_flown(sc, bottom, at, (cand, how), flights);
-        }
+    ) -> Option<Chosen<N>> {
         let inner = sc
-            .edge_waypoint(track)
-            .is_some_and(|end| libm::fabsf(offset(&kept.1.next, end)) < INNER);
+            .edge_waypoint(at.1)
+            .is_some_and(|end| libm::fabsf(offset(&kept.next, end)) < INNER);
         if !inner {
-            return Ok(kept);
+            return None;
         }
-        match self.certified_off_edge((sc, bottom), at, cand, flights) {
-            Some(c) => {
-                let flown = fly_committed(sc, at, c.depths[0], cand.flown, flights)?;
-                Ok((c, flown))
-            }
-            None => Ok(kept),
-        }
+        self.certified_off_edge((sc, bottom), at, cand, flights)
     }
 
     /// The candidate continuation where it certifies, no search made.
-    /// Not inlined: its frame stays off the commit's stack.
-    #[inline(never)]
     fn certified_off_edge(
         &mut self,
         (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),

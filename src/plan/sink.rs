@@ -42,8 +42,8 @@ use crate::optim::Bounds;
 use crate::sim::TrackScore;
 
 use super::Planner;
-use super::raise::raised;
 use super::objective::{PlanObjective, Stop};
+use super::raise::raised;
 use super::scan::with_depth;
 
 /// Sinks tried for one track (the band, doubling).
