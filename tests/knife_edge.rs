@@ -50,7 +50,7 @@ fn nearest_samples_of((p, w, c): (&str, &str, &str), mode: &[&str]) -> Vec<f64> 
         .skip(1)
         .map(|l| l.split(',').next().unwrap().parse().unwrap())
         .collect();
-    let wps: Vec<f64> = std::fs::read_to_string(&w)
+    let wps: Vec<f64> = std::fs::read_to_string(w)
         .unwrap()
         .lines()
         .skip(1)

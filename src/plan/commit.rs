@@ -26,38 +26,12 @@ use crate::sim::{Scenario, TrackScore, VehicleState, World};
 
 use super::candidate::Candidate;
 use super::certify::{ALL, Certificate, Tube};
+use super::chosen::Chosen;
 use super::fallback::{Flown, fly_committed};
 use super::knife::one_vehicle;
 use super::planner::{Continuation, MAX_TRACKS};
 use super::status::Found;
 use super::{Mode, Plan, PlanError, PlanStatus, Planner};
-
-/// A continuation with its certificate.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Chosen<const N: usize> {
-    pub(super) depths: [f32; MAX_TRACKS],
-    pub(super) len: usize,
-    pub(super) cert: Certificate,
-    /// Whether it was found on the search path (not the candidate itself).
-    pub(super) searched: bool,
-    /// Whether it is the previous call's continuation, its certificate
-    /// known (the candidate was no better).
-    pub(super) previous: bool,
-}
-
-impl<const N: usize> Chosen<N> {
-    /// The continuation `depths` (`len` tracks) with its certificate,
-    /// neither searched for nor the previous one.
-    pub(super) fn new(depths: [f32; MAX_TRACKS], len: usize, cert: Certificate) -> Self {
-        Self {
-            depths,
-            len,
-            cert,
-            searched: false,
-            previous: false,
-        }
-    }
-}
 
 /// A later call keeps the previous continuation, whose certificate it
 /// knows, unless the candidate lowers the line's `J` (the tracks committed

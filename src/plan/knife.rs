@@ -77,7 +77,7 @@ use crate::model::ProfileView;
 use super::Planner;
 use super::candidate::Candidate;
 use super::certify::ALL;
-use super::commit::Chosen;
+use super::chosen::Chosen;
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::MAX_TRACKS;

@@ -387,8 +387,7 @@ impl<const N: usize> Lift<N> {
                 if a >= self.target {
                     return Ok(Next::Deep((held, self.zj - up)));
                 }
-                // (A lifted depth still below track `j`'s start is a dive
-                // cut short, not a climb: module docs.)
+                // (A lifted depth below track `j`'s start: a dive, module docs.)
                 let climbs = up <= self.at_j.depth();
                 if a <= last + self.slack && climbs {
                     // The climb saturates: no lift frees more. (Past a

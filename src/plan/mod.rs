@@ -140,6 +140,7 @@ mod budget;
 mod candidate;
 mod carry;
 mod certify;
+mod chosen;
 mod commit;
 mod config;
 mod edge;

@@ -11,7 +11,7 @@ use crate::sim::Scenario;
 use super::Planner;
 use super::candidate::Candidate;
 use super::certify::Certificate;
-use super::commit::Chosen;
+use super::chosen::Chosen;
 use super::planner::MAX_TRACKS;
 
 /// The certified-altitude tolerance of the continuation search, m (as the
