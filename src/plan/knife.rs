@@ -70,9 +70,8 @@
 //! re-flight's; the candidate, 1.8 cm shallower, certifies (3 flights
 //! more) and they agree within a millimetre.
 
-use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, World, offset};
-
 use crate::model::ProfileView;
+use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, World, offset};
 
 use super::Planner;
 use super::candidate::Candidate;
@@ -199,29 +198,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     pub(super) fn off_kept_edge(
         &mut self,
         (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
-        at: (&VehicleState<N>, usize),
+        (state, track): (&VehicleState<N>, usize),
         (cand, kept): (&Candidate<N>, &Flown<N>),
         flights: &mut u32,
     ) -> Option<Chosen<N>> {
-        let inner = sc
-            .edge_waypoint(at.1)
-            .is_some_and(|end| libm::fabsf(offset(&kept.next, end)) < INNER);
-        if !inner {
-            return None;
-        }
-        self.certified_off_edge((sc, bottom), at, cand, flights)
-    }
-
-    /// The candidate continuation where it certifies, no search made.
-    fn certified_off_edge(
-        &mut self,
-        (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
-        (state, track): (&VehicleState<N>, usize),
-        cand: &Candidate<N>,
-        flights: &mut u32,
-    ) -> Option<Chosen<N>> {
+        let end = sc.edge_waypoint(track)?;
         let len = sc.waypoints().tracks().saturating_sub(track);
-        if len > MAX_TRACKS {
+        if libm::fabsf(offset(&kept.next, end)) >= INNER || len > MAX_TRACKS {
             return None;
         }
         self.tube
@@ -230,6 +213,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let horizon = (&self.work.z, self.horizon_len);
         let c = self.candidate_continuation((track, len), (cand.flown.depth, horizon), shallow);
         let cert = self.certify_candidate(sc, bottom, (state, cand), (&c, len), flights);
+        // (A failed certificate stops at its first world below `h_safe`:
+        // not flown in full for nothing.)
+        if cert.all < cand.h_safe {
+            return None;
+        }
         let chosen = self.completed(sc, bottom, Chosen::new(c, len, cert), flights);
         (chosen.cert.all >= cand.h_safe).then_some(chosen)
     }
