@@ -281,7 +281,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         iterations: u32,
     ) -> u32 {
-        if obj.last_violation > tol || iterations >= self.cfg.bfgs.max_iterations {
+        if !self.feasible_with_room(obj, tol, iterations) {
             return iterations;
         }
         let mut starts: [Option<Jump<K>>; K] = [None; K];

@@ -190,7 +190,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         mut iterations: u32,
     ) -> u32 {
-        if obj.last_violation > tol || iterations >= self.cfg.bfgs.max_iterations {
+        if !self.feasible_with_room(obj, tol, iterations) {
             return iterations;
         }
         for g in 1..h {

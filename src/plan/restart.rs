@@ -11,6 +11,18 @@ use super::Planner;
 use super::objective::PlanObjective;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
+    /// Whether an escape that restarts from a feasible SQP end may run:
+    /// the last point evaluated feasible within `tol` (m) and an iteration
+    /// of the cap left after `iterations`.
+    pub(super) fn feasible_with_room(
+        &self,
+        obj: &PlanObjective<'_, N>,
+        tol: f32,
+        iterations: u32,
+    ) -> bool {
+        obj.last_violation <= tol && iterations < self.cfg.bfgs.max_iterations
+    }
+
     /// The SQP restarted from `z` with the merit weight `rho` (m³/m; 0:
     /// learnt afresh), `careful` of the rows beyond the band or not
     /// (`optim/sqp.rs`), kept if it ends better than the workspace's:
