@@ -780,6 +780,19 @@ fn a_later_track_held_above_is_sunk() {
     horizon_within("sink_second", 1.01, 1.925_120e6);
 }
 
+/// An earlier track held above by a track three later
+/// (`check_planner.py --seed 2728 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_2728_3`): track 1 held
+/// at 812.5 m by track 5's least altitude, tracks 2 to 4 diving or
+/// climbing at the pitch limit between them, so that raising track 5's or
+/// track 4's depth moves nothing. The line's `J` was 1.419e7 m³, 1.72× the
+/// f64 beam search's best safe plan (8.271 204e6 m³); track 1 sunk with
+/// track 3 raised (`src/plan/sink.rs`), 1.0006×.
+#[test]
+fn an_earlier_track_held_by_a_far_track_is_sunk() {
+    horizon_within("sink_far", 1.01, 8.271_204e6);
+}
+
 /// A lift past a dive's plateau (`check_planner.py --seed 2730 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_2730_4`): lifts of 20
 /// and 40 m left track 4's saturated dive the same, and the search took

@@ -540,7 +540,7 @@ impl<const N: usize> Lift<N> {
         if obj.least_at(from, &z, k)? >= target - self.band {
             return Ok(start);
         }
-        let d = raised(obj, from, (&z, k), (target, self.band, lo))?;
+        let d = raised(obj, from, (&z, (k, k)), (target, self.band, lo))?;
         Ok(Some(d.map_or(z, |d| with_depth(&z, k, d))))
     }
 

@@ -14,16 +14,16 @@ const RAISES: u32 = 6;
 /// that frees a track's preferred depth: `lift.rs`).
 pub(super) const NARROW: u32 = 3;
 
-/// Depth `k` of `z` raised until track `k`, flown with the tracks from
-/// `j` on from `at_j` (the state track `j` starts in), clears `target`
-/// (m): shallower by `band` (m), doubling ([`RAISES`] times at most, not
-/// above `lo`, m), then [`NARROW`] bisections toward the last depth that
-/// did not clear it; one flight of tracks `j..=k` each. The deepest depth
-/// found that clears it, if any.
+/// Depth `k` of `z` raised until track `g` (`k ≤ g`), flown with the
+/// tracks from `j` on from `at_j` (the state track `j` starts in), clears
+/// `target` (m): shallower by `band` (m), doubling ([`RAISES`] times at
+/// most, not above `lo`, m), then [`NARROW`] bisections toward the last
+/// depth that did not clear it; one flight of tracks `j..=g` each. The
+/// deepest depth found that clears it, if any.
 pub(super) fn raised<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     (at_j, j): (&VehicleState<N>, usize),
-    (z, k): (&[f32; K], usize),
+    (z, (k, g)): (&[f32; K], (usize, usize)),
     (target, band, lo): (f32, f32, f32),
 ) -> Result<Option<f32>, Stop> {
     let Some(&zk) = z.get(k) else {
@@ -32,8 +32,8 @@ pub(super) fn raised<const N: usize, const K: usize>(
     let (mut held, mut step) = (zk, band);
     for _ in 0..RAISES {
         let up = crate::num::max(zk - step, lo);
-        if obj.least_at((at_j, j), &with_depth(z, k, up), k)? >= target {
-            let d = clearing(obj, (at_j, j), (k, target), (z, (k, |d| d)), (up, held))?;
+        if obj.least_at((at_j, j), &with_depth(z, k, up), g)? >= target {
+            let d = clearing(obj, (at_j, j), (g, target), (z, (k, |d| d)), (up, held))?;
             return Ok(Some(d));
         }
         if up <= lo {
