@@ -1112,7 +1112,7 @@ fn a_run_gone_back_restarts_at_the_edge_it_crossed() {
 /// target at 661.1 m: the line's `J` 2.394e7 m³, 1.56× the f64 beam
 /// search's best safe plan (1.534436e7 m³: 587.0, 922.1, 575.0, 504.9,
 /// 801.5 m), which flies track 1 shallower so that track 2 can dive.
-/// With `lift.rs`, 1.001×. The checker's bound is 1.10×.
+/// With `lift/`, 1.001×. The checker's bound is 1.10×.
 #[test]
 fn a_later_track_dives_once_the_one_before_is_lifted() {
     horizon_within("lift_earlier", 1.10, 1.534436e7);
@@ -1143,7 +1143,7 @@ fn a_lift_that_clears_a_plateau_frees_the_whole_dive() {
 /// The best safe plan (the f64 beam search: 1069.8, 1063.7, 766.4,
 /// 1225.5 m, line `J` 3.282938e6 m³) climbs on track 3, so that track 4
 /// can dive from higher and pass the rise 60 m above it. Before
-/// `lift.rs` sought track 4's preferred depth, 2.77×; now 1.001×. The
+/// `lift/` sought track 4's preferred depth, 2.77×; now 1.001×. The
 /// checker's bound is 1.10×.
 #[test]
 fn a_track_climbs_so_that_the_next_can_dive_past_a_rise() {

@@ -180,7 +180,7 @@ fn a_track_held_from_a_plateau_is_freed_at_its_edge() {
 /// metre, and the start was worse than the SQP's end. The line's `J`
 /// 2.2076e7 m³, 1.40× the f64 beam search's best safe plan (1.5732e7 m³:
 /// 214.8, 139.9, 285.2, 177.5 m). Now the lift also bisects for the
-/// deepest track 3 that clears its target (`plan/lift.rs`): 1.0007×. The
+/// deepest track 3 that clears its target (`plan/lift/`): 1.0007×. The
 /// checker's bound is 1.10×.
 #[test]
 fn a_lift_deepens_the_later_track_as_far_as_it_clears() {
@@ -358,7 +358,7 @@ fn a_plateau_with_a_gentle_edge_is_left() {
 /// lifting track 2 by 160 m freed it, but the start (track 3 deepened by
 /// the 2.5 m freed beyond the band) had a horizon `J` of 5.33e6 m³
 /// against the SQP's 4.48e6 m³ (1.19×) and was not tried (now: up to
-/// 1.25×, `FREED_SHARE` in `src/plan/lift.rs`). Restarted from it, the
+/// 1.25×, `FREED_SHARE` in `src/plan/lift/`). Restarted from it, the
 /// SQP flies track 2 101 m shallower and track 3 81 m deeper. The line's
 /// `J` was 4.48471e6 m³, 1.32× the f64 beam search's best safe plan
 /// (3.403426e6 m³); now 0.991×.
@@ -799,7 +799,7 @@ fn an_earlier_track_held_by_a_far_track_is_sunk() {
 /// it for a saturated climb; the best plan lifts track 4 by 116 m so that
 /// track 5 flies 47 m deeper. The line's `J` was 3.770e6 m³, 1.23× the
 /// f64 beam search's best safe plan (3.059 614e6 m³); lifted on
-/// (`src/plan/lift.rs`), 1.004×.
+/// (`src/plan/lift/`), 1.004×.
 #[test]
 fn a_lift_goes_on_past_a_dives_plateau() {
     horizon_within("lift_dive", 1.01, 3.059_614e6);

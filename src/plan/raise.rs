@@ -1,5 +1,5 @@
 //! A later track raised until it clears its target: the search the lift
-//! (`lift.rs`) makes for the track after a deepened one, and the sink
+//! (`lift/`) makes for the track after a deepened one, and the sink
 //! (`sink.rs`) for the track after a sunk one.
 
 use crate::sim::VehicleState;
@@ -11,7 +11,7 @@ use super::scan::with_depth;
 const RAISES: u32 = 6;
 
 /// Bisections of the deepest depth that clears (and of the least lift
-/// that frees a track's preferred depth: `lift.rs`).
+/// that frees a track's preferred depth: `lift/`).
 pub(super) const NARROW: u32 = 3;
 
 /// Depth `k` of `z` raised until track `g` (`k ≤ g`), flown with the

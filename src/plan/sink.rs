@@ -1,6 +1,6 @@
 //! A cold horizon whose SQP ends with an earlier track held above the
 //! depth its `J` wants by a later track's least altitude: the mirror of
-//! the lift (`lift.rs`). Sinking the earlier depth makes the vehicle
+//! the lift (`lift/`). Sinking the earlier depth makes the vehicle
 //! arrive deeper, so the later track must fly shallower to clear its
 //! target; the SQP weighs that trade at its end, where it is dear, but a
 //! larger sink can move the later track's lowest point to another dip
@@ -63,7 +63,7 @@ use super::scan::with_depth;
 const SINKS: u32 = 6;
 
 /// The sinks stop where a start's horizon `J` is more than this share
-/// above the SQP's (the lift's bound on a freed start: `lift.rs`).
+/// above the SQP's (the lift's bound on a freed start: `lift/`).
 const SHARE: f32 = 0.25;
 
 impl<const K: usize, const N: usize> Planner<K, N> {

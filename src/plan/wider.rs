@@ -91,7 +91,7 @@ const AGAIN: f32 = 0.8;
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// A cold call's escapes after its SQP, in order: the wide beam where
     /// the SQP ended infeasible by more than the band; then, without
-    /// declared uncertainty, the lift (`lift.rs`) and the held edge
+    /// declared uncertainty, the lift (`lift/`) and the held edge
     /// (`jump.rs`, `held_last`); then the sink (`sink.rs`); then the wide
     /// beam where a track of that
     /// end is held far above its bottom or its first depth has no
@@ -99,7 +99,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// edge again from it; then the first depth's
     /// stride (`stride.rs`); last, where those took the horizon's `J`
     /// below [`AGAIN`] of where the lift first ran, the lift and the held
-    /// edge once more (`lift.rs`' module docs). (The held track's restart
+    /// edge once more (`lift/`' module docs). (The held track's restart
     /// first ran before the lift, kept where it beat the SQP's end: on
     /// `check_planner.py --seed 2002 --vehicle
     /// tools/reference/vehicles/integ.toml`, `unseen_2002_0`, it took
@@ -151,14 +151,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         let iterations = self.stride_first(obj, (h, bounds), tol, iterations);
         // The lift and the held edge once more where the escapes took `J`
-        // well below where they ran (module docs of `lift.rs`).
+        // well below where they ran (module docs of `lift/`).
         if self.work.j < AGAIN * lifted_at {
             return self.lift_then_held(obj, (h, bounds), tol, iterations);
         }
         iterations
     }
 
-    /// The lift (`lift.rs`), then the held edge (`jump.rs`, `held_last`),
+    /// The lift (`lift/`), then the held edge (`jump.rs`, `held_last`),
     /// after `iterations` so far; returns the iterations so far.
     fn lift_then_held(
         &mut self,

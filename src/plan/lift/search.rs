@@ -1,0 +1,308 @@
+//! The lifts of one earlier depth by doubling, for the escape of the
+//! module above (`lift/mod.rs`): what they free of a later track, at its
+//! own depth, its preferred depth or its deepest useful one, and the
+//! starts made from them.
+
+use crate::plan::objective::{PlanObjective, Stop};
+use crate::plan::raise::{clearing, raised};
+use crate::plan::scan::with_depth;
+use crate::sim::{Scenario, VehicleState};
+
+/// Lifts tried for one track (the band, doubling).
+const LIFTS: u32 = 6;
+
+/// What is fixed while one later track's lift is sought.
+#[derive(Clone, Copy)]
+pub(super) struct Lift<const N: usize> {
+    /// The state track `j` starts in.
+    pub(super) at_j: VehicleState<N>,
+    /// The lifted track and the later one.
+    pub(super) j: usize,
+    pub(super) g: usize,
+    /// Their depths as the SQP left them, and depth `j`'s box floor, m.
+    pub(super) zj: f32,
+    pub(super) zg: f32,
+    pub(super) lo: f32,
+    /// Track `g`'s target altitude, the band `h_r − h_a` and the altitude
+    /// that counts as a gain, m.
+    pub(super) target: f32,
+    pub(super) band: f32,
+    pub(super) slack: f32,
+    /// Track `g`'s preferred depth where it is held above it, m.
+    pub(super) deep: Option<f32>,
+}
+
+/// What the lifts by doubling found.
+pub(super) enum Next<const K: usize> {
+    /// A start with track `g` deepened by the altitude freed; and, where
+    /// track `g` at its preferred depth does not clear its target at that
+    /// lift, the start with the deepest depth `g` found that does (its
+    /// least altitude may fall far slower than a metre per metre: a rise
+    /// passed early in the track, before the dive).
+    Freed([f32; K], Option<[f32; K]>),
+    /// The lifts `(held, free)` (m) between which track `g` at its
+    /// preferred depth first clears its target (`free` feasible), or
+    /// `(held, held)` where the climb saturates first.
+    Deep((f32, f32)),
+    /// A freed start, where the same lift also clears track `g` at its
+    /// preferred depth: its least altitude there is set by the earlier
+    /// track (a saturated dive's plateau), not by its own depth.
+    Both([f32; K], (f32, f32)),
+    Nothing,
+}
+
+impl<const N: usize> Lift<N> {
+    /// Depth `j` lifted by the band, doubling: one or two flights of the
+    /// two tracks per lift. With `past_freed`, a lift that frees track `g`
+    /// at its own depth but not at its deep one does not end the search:
+    /// the lifts go on for the deep depth alone (module docs).
+    pub(super) fn search<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        past_freed: bool,
+    ) -> Result<Next<K>, Stop> {
+        let mut plateau = None;
+        let next = self.lifts(obj, z, past_freed, &mut plateau)?;
+        Ok(match (next, plateau) {
+            (Next::Freed(start, _), Some(Next::Deep(l))) => Next::Both(start, l),
+            (Next::Nothing, Some(end)) => end,
+            (next, _) => next,
+        })
+    }
+
+    /// The lifts of [`Lift::search`]; `plateau` gets the end at the first
+    /// lift that left a dive's plateau the same (module docs).
+    fn lifts<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        mut z: [f32; K],
+        past_freed: bool,
+        plateau: &mut Option<Next<K>>,
+    ) -> Result<Next<K>, Stop> {
+        let (j, g) = (self.j, self.g);
+        let mut lift = self.band;
+        let mut held = 0.0;
+        // Track `g`'s least altitude at its preferred depth, last lift, m.
+        let mut last = f32::NEG_INFINITY;
+        // Whether a lift freed track `g` at its own depth already.
+        let mut passed = false;
+        for _ in 0..LIFTS {
+            let up = crate::num::max(self.zj - lift, self.lo);
+            z = with_depth(&z, j, up);
+            z = with_depth(&z, g, self.zg);
+            let freed = if passed {
+                f32::NEG_INFINITY
+            } else {
+                obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band
+            };
+            // Track `g`'s least altitude at its deep depth this lift, where
+            // the freeing branch flew it already.
+            let mut flown = None;
+            if freed >= 0.0 {
+                let start = with_depth(&z, g, self.zg + freed);
+                let Some(p) = self.deep.filter(|&p| p > self.zg + freed) else {
+                    return Ok(Next::Freed(start, None));
+                };
+                z = with_depth(&z, g, p);
+                let a = obj.least_at((&self.at_j, j), &z, g)?;
+                if a >= self.target {
+                    return Ok(Next::Both(start, (held, self.zj - up)));
+                }
+                if !past_freed {
+                    let deeper = self.deepest(obj, z, (self.zg + freed, p))?;
+                    return Ok(Next::Freed(start, Some(deeper)));
+                }
+                passed = true;
+                flown = Some(a);
+            }
+            if let Some(p) = self.deep {
+                z = with_depth(&z, g, p);
+                let a = match flown {
+                    Some(a) => a,
+                    None => obj.least_at((&self.at_j, j), &z, g)?,
+                };
+                if a >= self.target {
+                    return Ok(Next::Deep((held, self.zj - up)));
+                }
+                if a <= last + self.slack {
+                    // The climb saturates; below track `j`'s start, a dive,
+                    // whose end is kept for where no later lift frees more
+                    // (module docs).
+                    let end = self.saturated(a, passed, held);
+                    if up <= self.at_j.depth() {
+                        return Ok(end);
+                    }
+                    if plateau.is_none() {
+                        *plateau = Some(end);
+                    }
+                }
+                last = a;
+            }
+            if up <= self.lo {
+                // At the box's floor (the surface), track `g` at its deep
+                // depth within the band of its target: the start, as a
+                // saturated climb's (module docs).
+                if last >= self.target - self.band {
+                    return Ok(Next::Deep((self.zj - up, self.zj - up)));
+                }
+                break;
+            }
+            held = self.zj - up;
+            lift *= 2.0;
+        }
+        Ok(Next::Nothing)
+    }
+
+    /// The end of the search where track `g`'s least altitude at its deep
+    /// depth `a` (m) rises no more: the start at the lift `held` (m), or,
+    /// past a freeing lift (`passed`), only where `a` is within the band
+    /// of the target (module docs).
+    fn saturated<const K: usize>(&self, a: f32, passed: bool, held: f32) -> Next<K> {
+        if !passed || a >= self.target - self.band {
+            Next::Deep((held, held))
+        } else {
+            Next::Nothing
+        }
+    }
+
+    /// The start at track `g`'s deep depth (`self.deep`) with the least
+    /// lift that frees it, if the lifts by doubling find one (or the climb
+    /// saturates).
+    fn deep_start<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+    ) -> Result<Option<[f32; K]>, Stop> {
+        Ok(match self.search(obj, z, true)? {
+            Next::Deep(lifts) | Next::Both(_, lifts) => Some(self.narrowed(obj, z, lifts)?),
+            _ => None,
+        })
+    }
+
+    /// `z` with depth `g` the deepest in `[clear, held]` (m) at which track
+    /// `g` clears its target ([`Lift::clearing`]).
+    fn deepest<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        ends: (f32, f32),
+    ) -> Result<[f32; K], Stop> {
+        let d = self.clearing(obj, &z, (self.g, |d| d), ends)?;
+        Ok(with_depth(&z, self.g, d))
+    }
+
+    /// [`clearing`] for track `g` from the state track `j` starts in.
+    fn clearing<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: &[f32; K],
+        moved: (usize, impl Fn(f32) -> f32),
+        ends: (f32, f32),
+    ) -> Result<f32, Stop> {
+        let from = (&self.at_j, self.j);
+        clearing(obj, from, (self.g, self.target), (z, moved), ends)
+    }
+
+    /// Track `g` at its deepest useful depth (its deepest bottom less
+    /// `h_r`, m; not below `hi`, m), where that is more than the band
+    /// below the preferred one (module docs): a start restarted from after
+    /// the best one, since its `J` does not tell which ends better; with
+    /// track `g + 1` repaired ([`Lift::repaired`], `next_lo`).
+    pub(super) fn floor_start<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        (h_r, hi): (f32, f32),
+        next_lo: Option<f32>,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let floor = deepest(&obj.sc, obj.track.saturating_add(self.g), h_r)
+            .map(|p| p.min(hi))
+            .filter(|&p| p > self.deep.unwrap_or(self.zg) + self.band);
+        let lowest = match floor {
+            Some(p) => Lift {
+                deep: Some(p),
+                ..*self
+            }
+            .deep_start(obj, z)?,
+            None => None,
+        };
+        self.repaired(obj, lowest, next_lo)
+    }
+
+    /// `start` (if any) with track `g + 1`'s depth raised, where the start
+    /// leaves that track more than the band below its target, to the
+    /// deepest depth found that clears it ([`raised`]); one flight of
+    /// tracks `j..=g + 1` each, and one to see whether it is needed.
+    pub(super) fn repaired<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        start: Option<[f32; K]>,
+        lo: Option<f32>,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let k = self.g.saturating_add(1);
+        let (Some(z), Some(lo)) = (start, lo) else {
+            return Ok(start);
+        };
+        if k >= obj.count || z.get(k).is_none() {
+            return Ok(start);
+        }
+        let target = obj.target_of(k);
+        let from = (&self.at_j, self.j);
+        if obj.least_at(from, &z, k)? >= target - self.band {
+            return Ok(start);
+        }
+        let d = raised(obj, from, (&z, (k, k)), (target, self.band, lo))?;
+        Ok(Some(d.map_or(z, |d| with_depth(&z, k, d))))
+    }
+
+    /// The start at track `g`'s preferred depth with the least lift in
+    /// `(held, free]` that frees it, by [`NARROW`](super::raise::NARROW)
+    /// bisections (one flight of the two tracks each) where `free > held`.
+    pub(super) fn narrowed<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        (held, mut free): (f32, f32),
+    ) -> Result<[f32; K], Stop> {
+        let z = with_depth(&z, self.g, self.deep.unwrap_or(self.zg));
+        if free > held {
+            free = self.clearing(obj, &z, (self.j, |lift| self.zj - lift), (free, held))?;
+        }
+        Ok(with_depth(&z, self.j, self.zj - free))
+    }
+}
+
+/// The bottom depths (m) of the profile's samples on line track `t`;
+/// `None` for a track the line does not have.
+fn track_bottom<'s, const N: usize>(
+    sc: &'s Scenario<'_, N>,
+    t: usize,
+) -> Option<impl Iterator<Item = f32> + 's> {
+    let wp = sc.waypoints().positions();
+    let (&a, &b) = (wp.get(t)?, wp.get(t.saturating_add(1))?);
+    let p = sc.profile();
+    Some(
+        p.positions()
+            .iter()
+            .zip(p.depths())
+            .filter(move |&(&x, _)| x >= a && x <= b)
+            .map(|(_, &d)| d),
+    )
+}
+
+/// The deepest useful depth of line track `t`: its deepest bottom sample
+/// less `h_r` (m); `None` without samples.
+fn deepest<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
+    track_bottom(sc, t)?
+        .map(|d| d - h_r)
+        .reduce(crate::num::max)
+}
+
+/// The preferred depth of line track `t`: the mean of its bottom samples
+/// less the reference altitude `h_r` (m); `None` without samples.
+pub(super) fn preferred<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
+    let (sum, n) =
+        track_bottom(sc, t)?.fold((0.0_f32, 0_u32), |(s, n), d| (s + d, n.saturating_add(1)));
+    (n > 0).then(|| sum / n as f32 - h_r)
+}
