@@ -793,6 +793,19 @@ fn an_earlier_track_held_by_a_far_track_is_sunk() {
     horizon_within("sink_far", 1.01, 8.271_204e6);
 }
 
+/// A lift of the track before a saturated climb (`check_planner.py --seed
+/// 2770 --vehicle tools/reference/vehicles/integ.toml`, `unseen_2770_1`):
+/// track 3 held at its target, and track 2's climb saturated 80 m up with
+/// track 3 at its preferred depth 38 m short of its target. The best safe
+/// plan lifts track 1 by 47 m and track 2 past its saturation, for track
+/// 3 74 m deeper. The line's `J` was 1.127e7 m³, 1.63× the f64 beam
+/// search's best safe plan (6.924 37e6 m³); with track 1 lifted
+/// (`src/plan/lift/`), 1.0015×.
+#[test]
+fn the_track_before_a_saturated_climb_is_lifted() {
+    horizon_within("lift_before", 1.01, 6.924_37e6);
+}
+
 /// A lift past a dive's plateau (`check_planner.py --seed 2730 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_2730_4`): lifts of 20
 /// and 40 m left track 4's saturated dive the same, and the search took
