@@ -806,6 +806,19 @@ fn the_track_before_a_saturated_climb_is_lifted() {
     horizon_within("lift_before", 1.01, 6.924_37e6);
 }
 
+/// A sink where the SQP ended on a wrinkle (`check_planner.py --seed 2737
+/// --vehicle tools/reference/vehicles/slow.toml`, `unseen_2737_2`):
+/// `∂J/∂z_1` +380 m² at the SQP's end, though the line's `J` falls 2.0e6
+/// m³ over the next 158 m of sink, with track 3 at its target all the
+/// way; the sink of 160 m passes track 1's own target. The line's `J` was
+/// 9.622e6 m³, 1.27× the f64 beam search's best safe plan (7.600 944e6
+/// m³); sunk to the deepest depth found between 80 and 160 m that clears
+/// track 1 (`src/plan/sink.rs`), 1.0012×.
+#[test]
+fn a_sink_leaves_a_wrinkle_of_the_sqps_end() {
+    horizon_within("sink_wrinkle", 1.01, 7.600_944e6);
+}
+
 /// A lift past a dive's plateau (`check_planner.py --seed 2730 --vehicle
 /// tools/reference/vehicles/second.toml`, `unseen_2730_4`): lifts of 20
 /// and 40 m left track 4's saturated dive the same, and the search took

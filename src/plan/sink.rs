@@ -26,12 +26,14 @@
 //! 104 m. The line's `J` was 1.72× the f64 search's best; after, 1.0006×.
 //!
 //! The escape, for each earlier track `j` above its own target by more
-//! than the hundredth of the band (as the lift's), with `∂J/∂z_j < 0`,
+//! than the hundredth of the band (as the lift's), with `∂J/∂z_j ≠ 0`,
 //! and the first later track `g` at its target within as much (all read
 //! from one plain flight of the SQP's end): depth `j` sunk by the band
 //! `h_r − h_a`, doubling ([`SINKS`] times at most, within the box), while
 //! track `j` still clears its own target there (one flight of tracks
-//! `j..=g` tells both). At each sink where track `g` falls short, a depth
+//! `j..=g` tells both); the first sink that does not is bisected back
+//! toward the last that did ([`NARROW`](super::raise::NARROW) flights of
+//! track `j`), and its start is the last. At each sink where track `g` falls short, a depth
 //! from `g` back to `j + 1` is raised from where the last sink left the
 //! depths to the deepest found that clears `g`'s target
 //! ([`super::raise::raised`]): the first that can, from the depth the
@@ -50,13 +52,29 @@
 //! other than the next one (a round later) 6 more move, all lower
 //! (`unseen_3124_6` 0.66×, `unseen_2524_7` 0.77×, `unseen_3121_5` 0.97×),
 //! for 6.4 flights a line more; the 18 shared runs the same.
+//!
+//! The sign of `∂J/∂z_j` at the SQP's end does not tell what a sink of
+//! the band does: on `unseen_2737_2` (`--seed 2737`, `slow`) it was +380
+//! m² (a wrinkle: later tracks' `J` rises over the first metres), though
+//! the line's `J` falls 2.0e6 m³ over the next 158 m of sink with track 3
+//! at its target all the way. The sink is tried wherever the gradient is
+//! not exactly 0 (a depth on a plateau, its track saturated: sinking it
+//! moves nothing, and on Monterey 1 it cost the cold call 10 flights).
+//! There the sink of 160 m passed track 1's own target, and the deepest
+//! depth between 80 and 160 m that clears it is the best plan's: the
+//! line went from 1.27× to 1.0012× the f64 best. On the 267 random lines
+//! 6 move, 4 lower (`unseen_2507_4` 0.90×, `unseen_3104_4` 0.97×), 2
+//! higher (`unseen_3128_1` +0.24 %; `unseen_3103_3` +2.4 %: its cold
+//! call's horizon `J` is lower, 16.400e6 m³ against 16.424e6, and the
+//! later calls, which had improved on the old one, keep the new), for 0.5
+//! flights a line more; the 18 shared runs keep their plans and flights.
 
 use crate::optim::Bounds;
 use crate::sim::{TrackScore, VehicleState};
 
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
-use super::raise::raised;
+use super::raise::{clearing, raised};
 use super::scan::with_depth;
 
 /// Sinks tried for one track (the band, doubling).
@@ -87,11 +105,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return iterations;
         };
         for j in 0..h.saturating_sub(1) {
-            let deeper = self.work.gradient.get(j).is_some_and(|&d| d < 0.0);
+            // (Not a depth on a plateau: its track saturated, it moves
+            // nothing.)
+            let moves = self.work.gradient.get(j).is_some_and(|&d| d != 0.0);
             let Some(g) = held_above(obj, &scores, (j, h), slack) else {
                 continue;
             };
-            if !deeper {
+            if !moves {
                 continue;
             }
             let Ok(Some(z)) = self.sink_start(obj, bounds, (j, g)) else {
@@ -139,12 +159,21 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The sink, the depths as the last sink left them, and the depth
         // the last raise moved.
         let (mut sink, mut left, mut k) = (band, z, g);
-        for _ in 0..SINKS {
-            let down = crate::num::min(zj + sink, hi);
+        for n in 0..SINKS {
+            let mut down = crate::num::min(zj + sink, hi);
             let mut start = with_depth(&left, j, down);
-            let (least_j, least_g) = obj.least_pair(from, &start, g)?;
-            if least_j < own {
-                break;
+            let (least_j, mut least_g) = obj.least_pair(from, &start, g)?;
+            // Past track `j`'s own target: the deepest depth found since
+            // the last sink, which cleared it, and the last start.
+            let last = least_j < own;
+            if last {
+                if n == 0 {
+                    break;
+                }
+                let cleared = crate::num::min(zj + 0.5 * sink, hi);
+                down = clearing(obj, from, (j, own), (&start, (j, |d| d)), (cleared, down))?;
+                start = with_depth(&left, j, down);
+                least_g = obj.least_at(from, &start, g)?;
             }
             if least_g < target {
                 let raise = (from, (target, band));
@@ -158,7 +187,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if v <= band && jz < best.map_or(self.work.j, |(_, b)| b) {
                 best = Some((start, jz));
             }
-            if down >= hi || jz > (1.0 + SHARE) * self.work.j {
+            if last || down >= hi || jz > (1.0 + SHARE) * self.work.j {
                 break;
             }
             sink *= 2.0;
