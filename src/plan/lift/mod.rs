@@ -348,22 +348,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             lo,
             ..*l
         };
-        let starts = match before.search(obj, z, false)? {
-            Next::Freed(start, deeper) => [Some(start), deeper],
+        let (a, b) = match before.search(obj, z, false)? {
+            Next::Freed(start, deeper) => (Some(start), deeper),
             Next::Deep(lifts) | Next::Both(_, lifts) => {
-                [Some(before.narrowed(obj, z, lifts)?), None]
+                (Some(before.narrowed(obj, z, lifts)?), None)
             }
-            Next::Nothing => [None, None],
+            Next::Nothing => (None, None),
         };
-        let bar = (1.0 + FREED_SHARE) * self.work.j;
-        let mut best: Option<([f32; K], f32)> = None;
-        for start in starts.into_iter().flatten() {
-            let (jz, v) = obj.tail_value(&head, (&at_i, i), &start)?;
-            if v <= l.band && jz < best.map_or(bar, |(_, b)| b) {
-                best = Some((start, jz));
-            }
-        }
-        Ok(best.map(|(start, _)| start))
+        let (band, loose) = (l.band, (1.0 + FREED_SHARE) * self.work.j);
+        let starts = [(a, band, loose), (b, band, loose), (None, band, loose)];
+        Ok(ranked(obj, (&head, (&at_i, i)), starts, (band, loose))?.0)
     }
 }
 
