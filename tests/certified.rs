@@ -408,3 +408,80 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
     });
     assert!(checked > 600, "{checked}");
 }
+
+/// The vertical current declared alone (`check_certified.py --seed 2553
+/// --bounds-kind motion`, `synthetic_011`, fixture `current_fine`): the
+/// `plan` tool's line, track by track and in horizon mode. Track 5's climb
+/// saturates and the corner world `w_max` drops it 37 m below the nominal
+/// flight. With five levels of `w` a world at 0.0555 m/s, between 0.0371
+/// and 0.0742, flew track 5 0.15 m under its certified altitude in track
+/// mode; the nine levels used where `w` is declared alone catch it. Each
+/// track's certified altitude is at most its least altitude in 161 worlds
+/// across the declared current.
+#[test]
+fn the_certificate_bounds_every_current_between_its_samples() {
+    let mut cfg = VehicleConfig {
+        speed: 1.437,
+        sample_time: 0.0873,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 13.56;
+    cfg.autopilot.depth_pid = PidGains {
+        kp: 1.858,
+        ki: 0.02291,
+        kd: 1.547,
+    };
+    cfg.autopilot.pitch_pid = PidGains {
+        kp: 1.734,
+        ki: 0.1259,
+        kd: 2.254,
+    };
+    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
+    let w_max = 0.0742;
+    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, 0.0, w_max).unwrap();
+    let rel = "tests/fixtures/horizon/current_fine";
+    let (x, b) = (
+        csv_column(&format!("{rel}.csv"), 0),
+        csv_column(&format!("{rel}.csv"), 1),
+    );
+    let map = Profile::<4096>::new(&x, &b).unwrap();
+    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
+    let (h_r, h_a) = (41.13, 20.53);
+    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
+    let bottom = Profile::<8192>::new(&x, &b).unwrap();
+    let mut checked = 0;
+    for args in [&["--mode", "track"][..], &[][..]] {
+        let plan = tool::json_of_fixture("current_fine", args);
+        let tracks = plan["tracks"].as_array().unwrap();
+        let value = |k: &str| -> Vec<f32> {
+            tracks
+                .iter()
+                .map(|t| t[k].as_f64().unwrap() as f32)
+                .collect()
+        };
+        let (depths, certified) = (value("depth"), value("certified_min_altitude"));
+        checked += with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
+            let start = sc.start_state(d0);
+            let mut checked = 0;
+            for k in 0..=160 {
+                let world = World {
+                    speed: vehicle.speed(),
+                    flight_path_offset: 0.0,
+                    vertical_current: w_max * (k as f32 / 80.0 - 1.0),
+                };
+                let least = fly(sc, &world, &bottom, &start, &depths);
+                for (t, (&h, &c)) in least.iter().zip(&certified).enumerate() {
+                    assert!(
+                        c <= h + 1e-3,
+                        "{args:?} track {}: certified {c} m, flies {h} m at w = {} m/s",
+                        t + 1,
+                        world.vertical_current
+                    );
+                    checked += 1;
+                }
+            }
+            checked
+        });
+    }
+    assert_eq!(checked, 2 * 161 * 5);
+}
