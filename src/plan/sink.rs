@@ -42,8 +42,9 @@
 //! of the horizon: the sink whose start has the lowest `J`, below the
 //! SQP's and feasible within the band, restarts the SQP, kept where it
 //! ends better ([`Planner::sqp_restart`]). The sinks stop where a start's
-//! `J` is more than [`SHARE`] above the SQP's (without that stop, 15
-//! flights a line instead of 6.8, and the same plans). On the 267 random
+//! `J` is more than [`FREED_SHARE`] above the SQP's, the lift's bound on a
+//! freed start (without that stop, 15 flights a line instead of 6.8, and
+//! the same plans). On the 267 random
 //! lines 5 move, all lower (`unseen_2534_1` 0.61×, `unseen_3104_3` 0.92×,
 //! `unseen_3131_6` 0.95×), for 6.8 flights a line (1.8 % of the horizon
 //! mode's); the 18 shared runs keep their plans, at 2 flights more in
@@ -73,16 +74,13 @@ use crate::optim::Bounds;
 use crate::sim::{TrackScore, VehicleState};
 
 use super::Planner;
+use super::lift::FREED_SHARE;
 use super::objective::{PlanObjective, Stop};
 use super::raise::{clearing, raised};
 use super::scan::with_depth;
 
 /// Sinks tried for one track (the band, doubling).
 const SINKS: u32 = 6;
-
-/// The sinks stop where a start's horizon `J` is more than this share
-/// above the SQP's (the lift's bound on a freed start: `lift/`).
-const SHARE: f32 = 0.25;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The escape of the module docs over a horizon of `h` tracks in
@@ -187,7 +185,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if v <= band && jz < best.map_or(self.work.j, |(_, b)| b) {
                 best = Some((start, jz));
             }
-            if last || down >= hi || jz > (1.0 + SHARE) * self.work.j {
+            if last || down >= hi || jz > (1.0 + FREED_SHARE) * self.work.j {
                 break;
             }
             sink *= 2.0;

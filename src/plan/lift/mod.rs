@@ -190,7 +190,7 @@ use search::{Lift, Next, preferred};
 
 /// A freed start is tried where its horizon `J` is at most this share
 /// above the SQP's (module docs).
-const FREED_SHARE: f32 = 0.25;
+pub(super) const FREED_SHARE: f32 = 0.25;
 
 /// How far above its target (a share of the band `h_r − h_a`) a later
 /// track still counts as held where the depth loop integrates (module
