@@ -91,6 +91,41 @@ fn fly(
     }
 }
 
+/// Fixture `name` of `tests/fixtures/horizon/`: its map's samples (x and
+/// bottom depth, m), the map and its waypoints.
+fn fixture_line(name: &str) -> (Vec<f32>, Vec<f32>, Profile<4096>, Waypoints<16>) {
+    let rel = format!("tests/fixtures/horizon/{name}");
+    let (x, b) = (
+        csv_column(&format!("{rel}.csv"), 0),
+        csv_column(&format!("{rel}.csv"), 1),
+    );
+    let map = Profile::<4096>::new(&x, &b).unwrap();
+    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
+    (x, b, map, wps)
+}
+
+/// Flies `depths` from `start` in `world` over `bottom` and asserts that
+/// each track's certified altitude (`certified`, m) is at most its least
+/// altitude there (1 mm allowed); `what` names the plan. Returns the
+/// tracks checked.
+fn certified_bounds(
+    sc: &Scenario<'_, 3>,
+    (world, bottom): (&World, &Profile<8192>),
+    start: &VehicleState<3>,
+    (depths, certified): (&[f32], &[f32]),
+    what: &str,
+) -> usize {
+    let least = fly(sc, world, bottom, start, depths);
+    for (t, (&h, &c)) in least.iter().zip(certified).enumerate() {
+        assert!(
+            c <= h + 1e-3,
+            "{what} track {}: certified {c} m, flies {h} m in {world:?}",
+            t + 1
+        );
+    }
+    least.len().min(certified.len())
+}
+
 /// The line planned track by track from `start`, each call from the
 /// state the one before predicted, until a call fails (a start in the
 /// rock): each track's plan.
@@ -359,13 +394,7 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
     let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
     let alpha_max = 0.0649;
     let u = Uncertainty::new(6.88, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
-    let rel = "tests/fixtures/horizon/offset_jitter";
-    let (x, b) = (
-        csv_column(&format!("{rel}.csv"), 0),
-        csv_column(&format!("{rel}.csv"), 1),
-    );
-    let map = Profile::<4096>::new(&x, &b).unwrap();
-    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
+    let (_, _, map, wps) = fixture_line("offset_jitter");
     let x0 = wps.positions()[0];
     let mut rng = Lcg(0x2431_0ff5);
     let shifted: Vec<Profile<8192>> = [1.0, -1.0]
@@ -391,16 +420,9 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
                     vertical_current: 0.0,
                 };
                 for bottom in &shifted {
-                    let least = fly(sc, &world, bottom, &start, &depths);
-                    for (t, (&h, &c)) in least.iter().zip(&certified).enumerate() {
-                        assert!(
-                            c <= h + 1e-3,
-                            "{mode:?} track {}: certified {c} m, flies {h} m at α = {}°",
-                            t + 1,
-                            world.flight_path_offset
-                        );
-                        checked += 1;
-                    }
+                    let plan = (&depths[..], &certified[..]);
+                    let what = format!("{mode:?}");
+                    checked += certified_bounds(sc, (&world, bottom), &start, plan, &what);
                 }
             }
         }
@@ -439,13 +461,7 @@ fn the_certificate_bounds_every_current_between_its_samples() {
     let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
     let w_max = 0.0742;
     let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, 0.0, w_max).unwrap();
-    let rel = "tests/fixtures/horizon/current_fine";
-    let (x, b) = (
-        csv_column(&format!("{rel}.csv"), 0),
-        csv_column(&format!("{rel}.csv"), 1),
-    );
-    let map = Profile::<4096>::new(&x, &b).unwrap();
-    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
+    let (x, b, map, wps) = fixture_line("current_fine");
     let (h_r, h_a) = (41.13, 20.53);
     let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
     let bottom = Profile::<8192>::new(&x, &b).unwrap();
@@ -469,16 +485,9 @@ fn the_certificate_bounds_every_current_between_its_samples() {
                     flight_path_offset: 0.0,
                     vertical_current: w_max * (k as f32 / 80.0 - 1.0),
                 };
-                let least = fly(sc, &world, &bottom, &start, &depths);
-                for (t, (&h, &c)) in least.iter().zip(&certified).enumerate() {
-                    assert!(
-                        c <= h + 1e-3,
-                        "{args:?} track {}: certified {c} m, flies {h} m at w = {} m/s",
-                        t + 1,
-                        world.vertical_current
-                    );
-                    checked += 1;
-                }
+                let plan = (&depths[..], &certified[..]);
+                let what = format!("{args:?}");
+                checked += certified_bounds(sc, (&world, &bottom), &start, plan, &what);
             }
             checked
         });
