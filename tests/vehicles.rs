@@ -830,3 +830,18 @@ fn a_sink_leaves_a_wrinkle_of_the_sqps_end() {
 fn a_lift_goes_on_past_a_dives_plateau() {
     horizon_within("lift_dive", 1.01, 3.059_614e6);
 }
+
+/// A later track held where its dive ends (`check_planner.py --seed 2782
+/// --vehicle tools/reference/vehicles/integ.toml`, `unseen_2782_5`): the
+/// cold SQP ended with track 2 at its target at 678.3 m, its least
+/// altitude's row moved by its own depth (−0.57 m/m) and by track 1's
+/// (−0.46 m/m). A few metres deeper its dive saturates over that point,
+/// and track 1's depth alone sets it, 0.2 m short: the best safe plan
+/// lifts track 1 by 0.12 m so that track 2 flies 21 m deeper. The line's
+/// `J` was 1.368e7 m³, 1.16× the f64 beam search's best safe plan
+/// (1.179 635e7 m³); probed the quarter band deeper and restarted
+/// (`src/plan/probe.rs`), 1.065×, within the checker's bound.
+#[test]
+fn a_held_track_whose_dive_ends_is_probed_deeper() {
+    horizon_within("probe_blend", 1.10, 1.179_635e7);
+}

@@ -80,7 +80,33 @@ impl<const K: usize> Linearized<K> {
             (c <= active && g >= 1 && g < n && own == 0.0 && earlier).then_some(g)
         })
     }
+
+    /// The groups (bit `g`) with a row in transition: active (`c <=
+    /// active`, m), of a group `g` in `1..n`, moved at least [`BLENDED`]
+    /// a unit by its own column and by an earlier one. For the planner
+    /// that is a later track's least altitude set where its dive is ending:
+    /// the deeper its own depth, the longer the dive, and the more the
+    /// arrival (an earlier depth) sets it, until its own depth moves it no
+    /// more. The linearization sees its own depth still moving it.
+    pub(crate) fn blended(&self, active: f32, n: usize) -> u32 {
+        self.iter().fold(0, |bits, (c, a, g)| {
+            let g = usize::from(g);
+            let own = a.get(g).map_or(0.0, |v| libm::fabsf(*v));
+            let earlier = a.get(..g).map_or(0.0, |e| {
+                e.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)))
+            });
+            let bit = u32::try_from(g).ok().and_then(|g| 1_u32.checked_shl(g));
+            match bit {
+                Some(b) if c <= active && g < n && own >= BLENDED && earlier >= BLENDED => bits | b,
+                _ => bits,
+            }
+        })
+    }
 }
+
+/// How much a row's own column and an earlier one must each move it to
+/// count as in transition ([`Linearized::blended`]), m/m.
+pub(crate) const BLENDED: f32 = 0.1;
 
 /// A constrained objective.
 pub(crate) trait Constrained<const K: usize> {
@@ -135,5 +161,25 @@ mod tests {
         assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 0)]).kinked(0.1, 3), None);
         assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 2)]).kinked(0.1, 3), None);
         assert_eq!(lin(&[kinked]).kinked(0.1, 1), None);
+    }
+
+    #[test]
+    fn a_row_in_transition_is_moved_by_its_own_and_an_earlier_depth() {
+        // Track 2's row, active, moved by both depths (bit 1); track 3's
+        // too (bit 2).
+        let blended = (0.01, [-0.46, -0.57, 0.0], 1);
+        assert_eq!(lin(&[blended]).blended(0.1, 3), 0b10);
+        assert_eq!(
+            lin(&[blended, (0.0, [0.0, -0.2, -0.8], 2)]).blended(0.1, 3),
+            0b110
+        );
+        // Not active; settled on its own depth (the earlier column below
+        // a tenth); a dive's plateau (its own column below a tenth: the
+        // kink's); the first track's; a group past the horizon's `n`.
+        assert_eq!(lin(&[(0.5, [-0.46, -0.57, 0.0], 1)]).blended(0.1, 3), 0);
+        assert_eq!(lin(&[(0.0, [-0.05, -1.0, 0.0], 1)]).blended(0.1, 3), 0);
+        assert_eq!(lin(&[(0.0, [-1.07, 0.0, 0.0], 1)]).blended(0.1, 3), 0);
+        assert_eq!(lin(&[(0.0, [-1.0, 0.0, 0.0], 0)]).blended(0.1, 3), 0);
+        assert_eq!(lin(&[blended]).blended(0.1, 1), 0);
     }
 }

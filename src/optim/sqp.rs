@@ -178,6 +178,7 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     Ok(SqpEnd {
         rho: run.rho,
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
+        blended: run.lin.blended(kink_band(&run.lin, feas_tol), n),
         returned,
         left: (returned && left_j < run.lin.j).then_some(left),
         sliver: status == Status::Converged && run.sliver && !returned,
@@ -193,6 +194,9 @@ pub(crate) struct SqpEnd<const K: usize> {
     /// The group of a row active at a one-sided kink at the end
     /// ([`Linearized::kinked`]), if any.
     pub kink: Option<usize>,
+    /// The groups (bits) of rows active in transition at the end
+    /// ([`Linearized::blended`]).
+    pub blended: u32,
     /// Whether the run went back to its best feasible iterate
     /// (`best.rs`).
     pub returned: bool,

@@ -155,6 +155,7 @@ mod objective;
 mod planner;
 mod plateau;
 mod polish;
+mod probe;
 mod raise;
 mod restart;
 mod resumable;

@@ -42,6 +42,9 @@ pub struct Planner<const K: usize, const N: usize = 3> {
     /// `J` of the tracks committed since the worlds last started afresh,
     /// m³: the scale a later call's gain is weighed on (`commit.rs`).
     pub(super) line_j: f32,
+    /// The later tracks (bits) whose least altitude's row was in
+    /// transition where the workspace's last SQP run ended (`probe.rs`).
+    pub(super) blended: u32,
 }
 
 #[cfg(feature = "defmt")]
@@ -124,6 +127,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             budget: Budget::NONE,
             gaps: [0.0; MAX_TRACKS],
             line_j: 0.0,
+            blended: 0,
         })
     }
 

@@ -102,6 +102,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                         .flatten()
                 });
             if better {
+                self.blended = restart.as_ref().map_or(0, |end| end.blended);
                 total = Some(
                     so_far
                         .saturating_add(self.work.iterations)

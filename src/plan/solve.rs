@@ -157,6 +157,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         let end = run.map_err(start_error)?;
         let rho = end.rho;
+        self.blended = end.blended;
         let mut iterations = self.work.iterations;
         iterations = self.follow_up(obj, &end, (h, bounds), tol, iterations);
         let mut scanned = 0_u64;

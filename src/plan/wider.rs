@@ -92,7 +92,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// A cold call's escapes after its SQP, in order: the wide beam where
     /// the SQP ended infeasible by more than the band; then, without
     /// declared uncertainty, the lift (`lift/`) and the held edge
-    /// (`jump.rs`, `held_last`); then the sink (`sink.rs`); then the wide
+    /// (`jump.rs`, `held_last`); then the sink (`sink.rs`); then the probe
+    /// of a held track whose dive ends (`probe.rs`); then the wide
     /// beam where a track of that
     /// end is held far above its bottom or its first depth has no
     /// gradient, and where that restart is kept, the lift and the held
@@ -144,6 +145,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let lifted_at = self.work.j;
         iterations = self.lift_then_held(obj, (h, bounds), tol, iterations);
         iterations = self.sink_earlier(obj, (h, bounds), tol, iterations);
+        iterations = self.probe_deeper(obj, (h, bounds), tol, iterations);
         let at = (tol, h_safe, iterations);
         let iterations = match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
             Some(it) => self.lift_then_held(obj, (h, bounds), tol, it),
