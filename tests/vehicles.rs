@@ -114,6 +114,20 @@ fn a_basin_between_the_wider_and_the_widest_looks_is_found() {
     track_within("polish_gap", &UNCONSTRAINED, &[(0, 500.085)], 1, 475_915.0);
 }
 
+/// A descent from the polish's first look that ends in a dip beside the
+/// basin (`check_planner.py --seed 2807 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_2807_3`, track 4,
+/// unconstrained): BFGS ended at 1 078.17 m, the half-metre look and its
+/// descent at 1 078.67 m (221 704 m³), with a bump 2.5 m deeper and the
+/// basin 5 m deeper: 1.0055× the f64 best 220 499 m³ (1 083.870 m, from
+/// the tool's track 3). The wider looks once more from the descent's end
+/// find it.
+#[test]
+fn a_dip_beside_the_basin_is_looked_past() {
+    let premise = [(0, 1124.6635), (1, 1261.7787), (2, 1063.864)];
+    track_within("polish_again", &UNCONSTRAINED, &premise, 3, 220_499.0);
+}
+
 /// A sawtooth whose trend falls into the safe set's boundary
 /// (`check_planner.py --seed 2669 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2669_0`, track 1,
