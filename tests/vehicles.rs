@@ -859,3 +859,16 @@ fn a_lift_goes_on_past_a_dives_plateau() {
 fn a_held_track_whose_dive_ends_is_probed_deeper() {
     horizon_within("probe_blend", 1.10, 1.179_635e7);
 }
+
+/// A cold SQP that ends a little short (`check_planner.py --seed 2910
+/// --vehicle tools/reference/vehicles/twoki.toml`, `unseen_2910_0`): the
+/// run's line search failed at 5.758e6 m³ with track 2 0.78 m short of
+/// its target, near the best safe plan; the wide beam's restart ended
+/// feasible at 7.17e6 m³ and was kept, and the line's `J` was 7.123e6
+/// m³, 1.38× the f64 beam search's best safe plan (5.154 897e6 m³). The
+/// short end with track 2 raised by its shortfall and restarted
+/// (`src/plan/wider.rs`), 1.02×.
+#[test]
+fn a_cold_end_a_little_short_is_repaired() {
+    horizon_within("short_end", 1.05, 5.154_897e6);
+}

@@ -130,7 +130,7 @@ const REPAIRS: u32 = 4;
 /// ([`Planner::sqp_restart`]). Not inlined: its flight's scores stay off
 /// the restart's frame, which the SQP's sits on.
 #[inline(never)]
-fn repaired<const N: usize, const K: usize>(
+pub(super) fn repaired<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     z: &[f32; K],
     bounds: &Bounds<K>,
