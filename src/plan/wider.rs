@@ -83,7 +83,11 @@
 //! tools/reference/vehicles/twoki.toml` (`unseen_2910_0`) the cold SQP's
 //! line search failed at 5.76e6 m³ with track 2 0.78 m short; the wide
 //! beam's restart ended feasible at 7.17e6 m³, and the line's `J` was
-//! 1.38× the f64 search's best safe plan; repaired, 1.02×. On the 267
+//! 1.38× the f64 search's best safe plan; repaired, 1.02×. On `--seed
+//! 2815 --vehicle tools/reference/vehicles/slow.toml` (`unseen_2815_0`)
+//! the cold end was 0.11 m short, the wide beam's restart no better, and
+//! the call owed its escapes to the next (1.18×); repaired, the lift runs
+//! from a feasible end, 1.0008×. On the 267
 //! random lines no plan moves, at 0.4 flights a line; the 18 shared runs
 //! keep their plans and flights (Monterey 3's cold end is short by more
 //! than the band).
