@@ -872,3 +872,15 @@ fn a_held_track_whose_dive_ends_is_probed_deeper() {
 fn a_cold_end_a_little_short_is_repaired() {
     horizon_within("short_end", 1.05, 5.154_897e6);
 }
+
+/// A lift's restart that leaves an earlier track held (`check_planner.py
+/// --seed 2913 --vehicle tools/reference/vehicles/twoki.toml`,
+/// `unseen_2913_6`): the lift of track 3 for track 4 was kept and left
+/// track 3 at its target, held by track 2's arrival, after the lift had
+/// passed track 3 by. The line's `J` was 4.616e6 m³, 1.103× the f64 beam
+/// search's best safe plan (4.184 134e6 m³); the tracks before a kept
+/// restart looked at again (`src/plan/lift/`), 1.025×.
+#[test]
+fn the_tracks_before_a_kept_lift_are_looked_at_again() {
+    horizon_within("lift_again", 1.05, 4.184_134e6);
+}
