@@ -142,6 +142,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         (skip, far): (u64, bool),
     ) -> Result<(u32, u64), PlanError> {
+        // (No run's rows yet: the last call's must not steer this one.)
+        self.blended = 0;
         let run = sqp_into(
             obj,
             (z0, 0.0, false),
