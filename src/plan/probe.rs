@@ -37,7 +37,7 @@
 use crate::optim::Bounds;
 
 use super::Planner;
-use super::objective::PlanObjective;
+use super::objective::{PlanObjective, Stop};
 use super::scan::with_depth;
 
 /// How far deeper a held track is probed, a share of the band.
@@ -52,9 +52,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// altitude's row was in transition where the last kept SQP run ended
     /// (`Linearized::blended`), over a horizon of `h` tracks in `bounds`,
     /// feasible within `tol` (m), after `iterations`. Returns the
-    /// iterations so far. Not inlined: its state stays off the SQP runs'
-    /// stack.
-    #[inline(never)]
+    /// iterations so far.
     pub(super) fn probe_deeper(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
@@ -62,8 +60,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         mut iterations: u32,
     ) -> u32 {
-        let m = obj.sc.mission();
-        let band = m.reference_altitude() - m.min_altitude();
         for g in 1..h {
             let bit = u32::try_from(g).ok().and_then(|g| 1_u32.checked_shl(g));
             if bit.is_none_or(|b| self.blended & b == 0) {
@@ -72,28 +68,42 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if !self.feasible_with_room(obj, tol, iterations) {
                 break;
             }
-            let (Some(&zg), Some(&hi)) = (self.work.z.get(g), bounds.hi.get(g)) else {
-                continue;
+            let z = match self.probe_start(obj, bounds, g) {
+                Ok(Some(z)) => z,
+                Ok(None) => continue,
+                Err(_) => break,
             };
-            if zg + PROBE * band > hi {
-                continue;
-            }
-            let probe = with_depth(&self.work.z, g, zg + PROBE * band);
-            let Ok(flown) = obj.flight(&probe) else {
-                break;
-            };
-            let Ok((j, v)) = obj.value_of(&flown) else {
-                continue;
-            };
-            if v > SHORT * band || j >= self.work.j {
-                continue;
-            }
             if let Some(total) =
-                self.sqp_restart(obj, &probe, (h, bounds), (tol, 0.0, false), iterations)
+                self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
             {
                 iterations = total;
             }
         }
         iterations
+    }
+
+    /// The workspace with later track `g` [`PROBE`] of the band deeper, in
+    /// `bounds`, where its flight's `J` is lower and its shortfall summed
+    /// at most [`SHORT`] of the band (one flight). (Not inlined: its
+    /// flight's scores are not on the stack of the restart that follows.)
+    #[inline(never)]
+    fn probe_start(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        bounds: &Bounds<K>,
+        g: usize,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let m = obj.sc.mission();
+        let band = m.reference_altitude() - m.min_altitude();
+        let (Some(&zg), Some(&hi)) = (self.work.z.get(g), bounds.hi.get(g)) else {
+            return Ok(None);
+        };
+        if zg + PROBE * band > hi {
+            return Ok(None);
+        }
+        let probe = with_depth(&self.work.z, g, zg + PROBE * band);
+        let flown = obj.flight(&probe)?;
+        let (j, v) = obj.value_of(&flown)?;
+        Ok((v <= SHORT * band && j < self.work.j).then_some(probe))
     }
 }
