@@ -884,3 +884,15 @@ fn a_cold_end_a_little_short_is_repaired() {
 fn the_tracks_before_a_kept_lift_are_looked_at_again() {
     horizon_within("lift_again", 1.05, 4.184_134e6);
 }
+
+/// A sink whose first raise is dear (`check_planner.py --seed 2924
+/// --vehicle tools/reference/vehicles/twoki.toml`, `unseen_2924_0`):
+/// track 1 flew 15 m above its target, held by track 3 through track 2's
+/// saturated dive; the sink's raise of track 3's own depth cleared it
+/// 270 m up, at 2.9× the SQP's `J`, and the sink stopped. The line's `J`
+/// was 8.615e6 m³, 1.35× the f64 beam search's best safe plan (6.393
+/// 215e6 m³); track 2 raised instead (`src/plan/sink.rs`), 1.00006×.
+#[test]
+fn a_dear_raise_gives_way_to_the_depth_before_it() {
+    horizon_within("sink_dear", 1.01, 6.393_215e6);
+}
