@@ -882,7 +882,7 @@ fn a_cold_end_a_little_short_is_repaired() {
 /// restart looked at again (`src/plan/lift/`), 1.025×.
 #[test]
 fn the_tracks_before_a_kept_lift_are_looked_at_again() {
-    horizon_within("lift_again", 1.05, 4.184_134e6);
+    horizon_within("lift_held_after", 1.05, 4.184_134e6);
 }
 
 /// A sink whose first raise is dear (`check_planner.py --seed 2924
