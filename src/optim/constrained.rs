@@ -82,8 +82,8 @@ impl<const K: usize> Linearized<K> {
     }
 
     /// The groups (bit `g`) with a row in transition: active (`c <=
-    /// active`, m), of a group `g` in `1..n`, moved at least [`BLENDED`]
-    /// a unit by its own column and by an earlier one. For the planner
+    /// active`, m), of a group `g` in `1..n`, whose own column and an
+    /// earlier one are each at least [`BLENDED`] in magnitude (m/m). For the planner
     /// that is a later track's least altitude set where its dive is ending:
     /// the deeper its own depth, the longer the dive, and the more the
     /// arrival (an earlier depth) sets it, until its own depth moves it no

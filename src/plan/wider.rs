@@ -111,14 +111,13 @@ const AGAIN: f32 = 0.8;
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// A cold call's escapes after its SQP, in order: the wide beam where
     /// the SQP ended infeasible by more than the band; then, without
-    /// declared uncertainty, the short end repaired (module docs), the lift (`lift/`) and the held edge
-    /// (`jump.rs`, `held_last`); then the sink (`sink.rs`); then the probe
-    /// of a held track whose dive ends (`probe.rs`); then the wide
-    /// beam where a track of that
-    /// end is held far above its bottom or its first depth has no
-    /// gradient, and where that restart is kept, the lift and the held
-    /// edge again from it; then the first depth's
-    /// stride (`stride.rs`); last, where those took the horizon's `J`
+    /// declared uncertainty, the short end repaired (module docs), the
+    /// lift (`lift/`) and the held edge (`jump.rs`, `held_last`); then the
+    /// sink (`sink.rs`); then the probe of a held track whose dive ends
+    /// (`probe.rs`); then the wide beam where a track of that end is held
+    /// far above its bottom or its first depth has no gradient, and where
+    /// that restart is kept, the lift and the held edge again from it;
+    /// then the first depth's stride (`stride.rs`); last, where those took the horizon's `J`
     /// below [`AGAIN`] of where the lift first ran, the lift and the held
     /// edge once more (`lift/`' module docs). (The held track's restart
     /// first ran before the lift, kept where it beat the SQP's end: on
