@@ -494,3 +494,24 @@ fn the_certificate_bounds_every_current_between_its_samples() {
     }
     assert_eq!(checked, 2 * 161 * 5);
 }
+
+/// With nothing declared, every track's `certified_min_altitude` is its
+/// `min_altitude` (spec/cli.md), after a predicted collision too
+/// (`check_certified.py --seed 2567 --bounds-kind motion`,
+/// `synthetic_008`, track mode): the planner flies the tracks after it
+/// from the climb's state, and the tool certified the fixed depths after
+/// it over the certification bottom; both were 0.10 m below the line's
+/// flight on tracks 4 and 5.
+#[test]
+fn nothing_declared_certifies_the_line_s_own_least_altitude() {
+    for (args, collides) in [(&["--mode", "track"][..], true), (&[], false)] {
+        let plan = tool::json_of_fixture("collision_nominal", args);
+        let tracks = plan["tracks"].as_array().unwrap();
+        let below = |t: &serde_json::Value| t["min_altitude"].as_f64().unwrap() < 0.0;
+        assert_eq!(tracks.iter().any(below), collides, "{args:?}");
+        for t in tracks {
+            let (m, c) = (&t["min_altitude"], &t["certified_min_altitude"]);
+            assert_eq!(m.as_f64(), c.as_f64(), "{args:?}: track {}", t["track"]);
+        }
+    }
+}
