@@ -203,13 +203,18 @@ fn run(args: Result<Args, Fail>) -> Result<(), Fail> {
             .zip(&fixed_cert)
             .map(|(((s, &depth), eff), &fixed)| {
                 let (certified_min_altitude, safe, status) = match eff.certified {
-                    Some(planned) => no_better_than_the_line(planned, fixed, declared, eff.status),
+                    Some(planned) => no_better_than_the_line(planned, fixed, eff.status),
                     None => (fixed.0, fixed.1, eff.status),
                 };
                 let safe = safe && !eff.after_crash;
                 // With nothing declared, the line's nominal flight's least
-                // altitude, as spec/cli.md says (module docs of
-                // `no_better_than_the_line`).
+                // altitude, as spec/cli.md says: after a predicted
+                // collision the planner's flight starts from the climb's
+                // state, and the tool certifies the fixed depths after it
+                // over the certification bottom, both a little off the
+                // line's flight (`check_certified.py --seed 2567
+                // --bounds-kind motion`, `synthetic_008`, track mode:
+                // 0.10 m).
                 let certified_min_altitude = if declared {
                     certified_min_altitude
                 } else {
@@ -392,22 +397,16 @@ fn sanity(
 /// `Planner::carry`); a planner whose worlds started again from a later
 /// state would not carry the spread the declared worlds had built up by
 /// then, and spec/cli.md's promise is for the line flown open loop from
-/// the start state. With nothing `declared` the altitude stays the nominal
-/// flight's and only `safe` takes the line's (a knife edge's other
-/// switch); the report then puts the line's nominal `min_altitude` in its
-/// place, as spec/cli.md says: after a predicted collision the planner's
-/// flight starts from the climb's state, and the tool certifies the fixed
-/// depths after it over the certification bottom, both a little off the
-/// line's flight (`check_certified.py --seed 2567 --bounds-kind motion`,
-/// `synthetic_008`, track mode: 0.10 m). A track the line does not
-/// certify is not safe: `infeasible`.
+/// the start state. (With nothing declared the report gives the line's
+/// nominal `min_altitude` instead, and only `safe` comes from here: a
+/// knife edge's other switch.) A track the line does not certify is not
+/// safe: `infeasible`.
 fn no_better_than_the_line(
     (planned, planned_safe): (f32, bool),
     (line, line_safe): (f32, bool),
-    declared: bool,
     status: &'static str,
 ) -> (f32, bool, &'static str) {
-    let certified = if declared { planned.min(line) } else { planned };
+    let certified = planned.min(line);
     let safe = planned_safe && line_safe;
     let status = if planned_safe && !safe {
         "infeasible"

@@ -95,13 +95,18 @@ impl<const K: usize> Linearized<K> {
             let earlier = a.get(..g).map_or(0.0, |e| {
                 e.iter().fold(0.0_f32, |m, v| m.max(libm::fabsf(*v)))
             });
-            let bit = u32::try_from(g).ok().and_then(|g| 1_u32.checked_shl(g));
-            match bit {
+            match group_bit(g) {
                 Some(b) if c <= active && g < n && own >= BLENDED && earlier >= BLENDED => bits | b,
                 _ => bits,
             }
         })
     }
+}
+
+/// Group `g`'s bit in a set of groups ([`Linearized::blended`]), if it
+/// has one.
+pub(crate) fn group_bit(g: usize) -> Option<u32> {
+    u32::try_from(g).ok().and_then(|g| 1_u32.checked_shl(g))
 }
 
 /// How much a row's own column and an earlier one must each move it to

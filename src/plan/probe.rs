@@ -35,6 +35,7 @@
 //! (+21 flights a line, two lines 1.0 % and 1.6 % higher).
 
 use crate::optim::Bounds;
+use crate::optim::constrained::group_bit;
 
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
@@ -61,8 +62,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         mut iterations: u32,
     ) -> u32 {
         for g in 1..h {
-            let bit = u32::try_from(g).ok().and_then(|g| 1_u32.checked_shl(g));
-            if bit.is_none_or(|b| self.blended & b == 0) {
+            if group_bit(g).is_none_or(|b| self.blended & b == 0) {
                 continue;
             }
             if !self.feasible_with_room(obj, tol, iterations) {
