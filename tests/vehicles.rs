@@ -896,3 +896,16 @@ fn the_tracks_before_a_kept_lift_are_looked_at_again() {
 fn a_dear_raise_gives_way_to_the_depth_before_it() {
     horizon_within("sink_dear", 1.01, 6.393_215e6);
 }
+
+/// A raise past the band's reach (`check_planner.py --seed 2943 --vehicle
+/// tools/reference/vehicles/tight.toml`, `unseen_2943_2`, band 4 m): the
+/// cold SQP held track 2 337 m above its bottom for track 3, whose dive
+/// at the pitch limit passed a rise at its target; after the sink of track
+/// 2, no raise of track 3 by doubling (up to 128 m) cleared it. The line's
+/// `J` was 7.135e7 m³, 1.21× the f64 beam search's best safe plan
+/// (5.893 808e7 m³); one raise more to the settled depth
+/// (`src/plan/raise.rs`), 1.0003×.
+#[test]
+fn a_raise_reaches_the_settled_depth() {
+    horizon_within("raise_settled", 1.05, 5.893_808e7);
+}

@@ -136,6 +136,7 @@
 //! | `fallback.rs` | the closest safe depth, the safe-set boundary |
 
 mod answer;
+mod bottom;
 mod budget;
 mod candidate;
 mod carry;

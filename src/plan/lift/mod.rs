@@ -197,7 +197,8 @@ use super::scan::with_depth;
 
 mod search;
 
-use search::{Lift, Next, preferred};
+use super::bottom::preferred;
+use search::{Lift, Next};
 
 /// A freed start is tried where its horizon `J` is at most this share
 /// above the SQP's (module docs).

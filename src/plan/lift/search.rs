@@ -3,10 +3,11 @@
 //! own depth, its preferred depth or its deepest useful one, and the
 //! starts made from them.
 
+use crate::plan::bottom::deepest;
 use crate::plan::objective::{PlanObjective, Stop};
 use crate::plan::raise::{clearing, raised};
 use crate::plan::scan::with_depth;
-use crate::sim::{Scenario, VehicleState};
+use crate::sim::VehicleState;
 
 /// Lifts tried for one track (the band, doubling).
 const LIFTS: u32 = 6;
@@ -271,38 +272,4 @@ impl<const N: usize> Lift<N> {
         }
         Ok(with_depth(&z, self.j, self.zj - free))
     }
-}
-
-/// The bottom depths (m) of the profile's samples on line track `t`;
-/// `None` for a track the line does not have.
-fn track_bottom<'s, const N: usize>(
-    sc: &'s Scenario<'_, N>,
-    t: usize,
-) -> Option<impl Iterator<Item = f32> + 's> {
-    let wp = sc.waypoints().positions();
-    let (&a, &b) = (wp.get(t)?, wp.get(t.saturating_add(1))?);
-    let p = sc.profile();
-    Some(
-        p.positions()
-            .iter()
-            .zip(p.depths())
-            .filter(move |&(&x, _)| x >= a && x <= b)
-            .map(|(_, &d)| d),
-    )
-}
-
-/// The deepest useful depth of line track `t`: its deepest bottom sample
-/// less `h_r` (m); `None` without samples.
-fn deepest<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
-    track_bottom(sc, t)?
-        .map(|d| d - h_r)
-        .reduce(crate::num::max)
-}
-
-/// The preferred depth of line track `t`: the mean of its bottom samples
-/// less the reference altitude `h_r` (m); `None` without samples.
-pub(super) fn preferred<const N: usize>(sc: &Scenario<'_, N>, t: usize, h_r: f32) -> Option<f32> {
-    let (sum, n) =
-        track_bottom(sc, t)?.fold((0.0_f32, 0_u32), |(s, n), d| (s + d, n.saturating_add(1)));
-    (n > 0).then(|| sum / n as f32 - h_r)
 }
