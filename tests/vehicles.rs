@@ -909,3 +909,17 @@ fn a_dear_raise_gives_way_to_the_depth_before_it() {
 fn a_raise_reaches_the_settled_depth() {
     horizon_within("raise_settled", 1.05, 5.893_808e7);
 }
+
+/// A lift past a plateau (`check_planner.py --seed 2941 --vehicle
+/// tools/reference/vehicles/heavy.toml`, `unseen_2941_6`): the cold SQP
+/// held track 4 at its target over a rise; lifted 20 and 40 m, track 3
+/// left track 4 at its preferred depth as short as before (the vehicle
+/// settled on it before the rise), and the lifts ended as on a saturated
+/// climb. The best safe plan climbs 160 m and more on track 3 so that the
+/// sluggish dive passes the rise above its target. The line's `J` was
+/// 6.955e6 m³, 1.248× the f64 beam search's best safe plan (5.573 148e6
+/// m³); with the far lift (`src/plan/lift/search.rs`), 0.996×.
+#[test]
+fn a_lift_looks_past_a_plateau_where_the_track_settles() {
+    horizon_within("lift_far", 1.05, 5.573_148e6);
+}

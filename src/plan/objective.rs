@@ -233,6 +233,23 @@ impl<const N: usize> PlanObjective<'_, N> {
     }
 
     /// Tracks `j..=g` of the horizon flown at `z` from `at_j`, the state
+    /// track `j` starts in: track `g`'s least altitude (m) and track `j`'s
+    /// `J` (m³). One flight, counted.
+    pub fn least_and_j<const K: usize>(
+        &mut self,
+        (at_j, j): (&VehicleState<N>, usize),
+        z: &[f32; K],
+        g: usize,
+    ) -> Result<(f32, f32), Stop> {
+        let used = z.get(j..=g).ok_or(Stop::Sim(SimError::TrackRange))?;
+        let flown = self.fly_from::<K>((at_j, j), used)?;
+        match (flown.first(), flown.get(g.saturating_sub(j))) {
+            (Some(a), Some(b)) => Ok((b.min_altitude(), a.j())),
+            _ => Err(Stop::Sim(SimError::TrackRange)),
+        }
+    }
+
+    /// Tracks `j..=g` of the horizon flown at `z` from `at_j`, the state
     /// track `j` starts in: the least altitudes of tracks `j` and `g`, m.
     /// One flight, counted.
     pub fn least_pair<const K: usize>(

@@ -123,6 +123,27 @@
 //! move, both lower: `unseen_3112_3` 1.024× → 0.959×; 0.7 flights a line
 //! more).
 //!
+//! A climb that does not saturate can leave track `g` as short as the
+//! last lift did too: the vehicle settles on track `g`'s deep depth
+//! before its least altitude, whatever the lift, until a lift so far that
+//! the dive is still under way there. Where track `g − 1`'s `J` moved
+//! between the two lifts (by more than `MOVED` of it, `search.rs`: the climb
+//! is not saturated), one far lift is flown, `FAR` bands (the
+//! doubling's reach; not above the box); where it frees track `g` at its
+//! deep depth, the least lift that does is narrowed as above, and that
+//! start is restarted after the best of the others where its horizon `J`
+//! is below the SQP's (the plateau's start is still ranked: on a line it
+//! alone ends better). On `check_planner.py --seed 2941 --vehicle
+//! tools/reference/vehicles/heavy.toml` (`unseen_2941_6`) lifts of 20 and
+//! 40 m left track 4 at its preferred depth 53 m short; the best plan
+//! climbs 160 m and more on track 3, so that the sluggish dive passes the
+//! rise above its target and track 5 flies 250 m deeper. The line's `J`
+//! was 1.248× the f64 search's best safe plan; after, 0.996×. On 304
+//! random lines on the ten vehicles of `tools/reference/vehicles/` and
+//! the default, none moves, 1.7 flights a line more; the 18 shared runs
+//! keep their plans, Monterey 1's flights too, and Medes 1 and 2,
+//! Aburatsubo and Monterey 2 fly 1 to 3 more times.
+//!
 //! A lift that reaches the box's floor (the surface) with track `g` at
 //! its deep depth within the band of its target is a start too, as a
 //! saturated climb's: on `check_planner.py --seed 2542 --vehicle
@@ -198,7 +219,7 @@ use super::scan::with_depth;
 mod search;
 
 use super::bottom::preferred;
-use search::{Lift, Next};
+use search::{Lift, Next, Starts};
 
 /// A freed start is tried where its horizon `J` is at most this share
 /// above the SQP's (module docs).
@@ -266,7 +287,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         bounds: &Bounds<K>,
         g: usize,
         tol: f32,
-    ) -> Result<[Option<[f32; K]>; 3], Stop> {
+    ) -> Result<Starts<K>, Stop> {
         let h_r = obj.sc.mission().reference_altitude();
         let band = h_r - obj.sc.mission().min_altitude();
         let teeth = if obj.teeth() { TEETH_SLACK * band } else { 0.0 };
@@ -276,12 +297,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let (head, at_j) = obj.head(&z, j)?;
         let target = obj.target_of(g);
         if obj.least_at((&at_j, j), &z, g)? > target + slack {
-            return Ok([None; 3]);
+            return Ok([None; 4]);
         }
         let (Some(&zj), Some(&zg), Some(&lo), Some(&hi)) =
             (z.get(j), z.get(g), bounds.lo.get(j), bounds.hi.get(g))
         else {
-            return Ok([None; 3]);
+            return Ok([None; 4]);
         };
         let l = Lift {
             at_j,
@@ -303,18 +324,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // left it; a start at the preferred depth may be far from it, the
         // climb saturated, and the restart's first steps close that.)
         let found = l.search(obj, z, false)?;
-        // The lift at which track `j`'s climb saturated short of freeing
-        // track `g` at its deep depth, if it did.
-        let saturated = match found {
-            Next::Deep((held, free)) if free <= held && held >= band => Some(held),
-            _ => None,
-        };
-        let (freed, deeper, deep) = match found {
-            Next::Freed(start, deeper) => (Some(start), deeper, None),
-            Next::Deep(lifts) => (None, None, Some(l.narrowed(obj, z, lifts)?)),
-            Next::Both(start, lifts) => (Some(start), None, Some(l.narrowed(obj, z, lifts)?)),
-            Next::Nothing => (None, None, None),
-        };
+        let (saturated, [freed, deeper, far, deep]) = l.starts(obj, z, found)?;
         // The deepest depth's start, and the freed start's deepest depth
         // `g`, with the track after `g` raised where it leaves it more than
         // the band below its target (module docs).
@@ -330,15 +340,16 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             (deep, f32::INFINITY, sqp),
         ];
         let (best, deep_j) = ranked(obj, (&head, (&at_j, j)), starts, (band, loose))?;
-        let lowest = match lowest {
-            Some(start) if obj.tail_value(&head, (&at_j, j), &start)?.0 < sqp => Some(start),
-            _ => None,
+        let mut below = |start: Option<[f32; K]>| match start {
+            Some(start) if obj.tail_value(&head, (&at_j, j), &start)?.0 < sqp => Ok(Some(start)),
+            _ => Ok(None),
         };
+        let (far, lowest) = (below(far)?, below(lowest)?);
         let before = match saturated {
             Some(lift) if j > 0 && deep_j < sqp => self.lift_before(obj, bounds, &l, (z, lift))?,
             _ => None,
         };
-        Ok([best, lowest, before])
+        Ok([best, far, lowest, before])
     }
 
     /// The lift before a saturated one (module docs): where the lift of
@@ -371,7 +382,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         let (a, b) = match before.search(obj, z, false)? {
             Next::Freed(start, deeper) => (Some(start), deeper),
-            Next::Deep(lifts) | Next::Both(_, lifts) => {
+            Next::Deep(lifts) | Next::Both(_, lifts) | Next::Far(lifts, _) => {
                 (Some(before.narrowed(obj, z, lifts)?), None)
             }
             Next::Nothing => (None, None),

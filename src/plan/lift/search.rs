@@ -12,6 +12,13 @@ use crate::sim::VehicleState;
 /// Lifts tried for one track (the band, doubling).
 const LIFTS: u32 = 6;
 
+/// The far lift, in bands: the doubling's reach (module docs).
+const FAR: f32 = 32.0;
+
+/// The relative change of track `j`'s `J` between two lifts that tells
+/// that its flight moved: its climb did not saturate.
+const MOVED: f32 = 1e-4;
+
 /// What is fixed while one later track's lift is sought.
 #[derive(Clone, Copy)]
 pub(super) struct Lift<const N: usize> {
@@ -33,6 +40,9 @@ pub(super) struct Lift<const N: usize> {
     pub(super) deep: Option<f32>,
 }
 
+/// The starts a lift search makes (`Lift::starts`).
+pub(super) type Starts<const K: usize> = [Option<[f32; K]>; 4];
+
 /// What the lifts by doubling found.
 pub(super) enum Next<const K: usize> {
     /// A start with track `g` deepened by the altitude freed; and, where
@@ -49,14 +59,22 @@ pub(super) enum Next<const K: usize> {
     /// preferred depth: its least altitude there is set by the earlier
     /// track (a saturated dive's plateau), not by its own depth.
     Both([f32; K], (f32, f32)),
+    /// The lifts `(held, free)` (m) between which the far lift freed track
+    /// `g` at its deep depth, past a plateau on which its least altitude
+    /// was set by its own depth; and the plateau's end, as
+    /// [`Next::Deep`]'s `(held, held)`.
+    Far((f32, f32), (f32, f32)),
     Nothing,
 }
 
 impl<const N: usize> Lift<N> {
     /// Depth `j` lifted by the band, doubling: one or two flights of the
-    /// two tracks per lift. With `past_freed`, a lift that frees track `g`
-    /// at its own depth but not at its deep one does not end the search:
-    /// the lifts go on for the deep depth alone (module docs).
+    /// two tracks per lift, and one for the far lift where track `g`
+    /// settles on a plateau while track `j`'s flight moves (`lift/`'s
+    /// module docs). With `past_freed`, a lift that frees track `g` at
+    /// its own depth but not at its deep one does not end the search: the
+    /// lifts go on for the deep depth alone (module docs), and there is
+    /// no far lift.
     pub(super) fn search<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -86,6 +104,8 @@ impl<const N: usize> Lift<N> {
         let mut held = 0.0;
         // Track `g`'s least altitude at its preferred depth, last lift, m.
         let mut last = f32::NEG_INFINITY;
+        // Track `j`'s `J` at the last lift, m³ (NaN: not flown).
+        let mut last_j = f32::NAN;
         // Whether a lift freed track `g` at its own depth already.
         let mut passed = false;
         for _ in 0..LIFTS {
@@ -101,38 +121,30 @@ impl<const N: usize> Lift<N> {
             // the freeing branch flew it already.
             let mut flown = None;
             if freed >= 0.0 {
-                let start = with_depth(&z, g, self.zg + freed);
-                let Some(p) = self.deep.filter(|&p| p > self.zg + freed) else {
-                    return Ok(Next::Freed(start, None));
-                };
-                z = with_depth(&z, g, p);
-                let a = obj.least_at((&self.at_j, j), &z, g)?;
-                if a >= self.target {
-                    return Ok(Next::Both(start, (held, self.zj - up)));
+                match self.freeing(obj, &mut z, freed, (held, up), past_freed)? {
+                    Ok(end) => return Ok(end),
+                    Err(a) => (passed, flown) = (true, Some(a)),
                 }
-                if !past_freed {
-                    let deeper = self.deepest(obj, z, (self.zg + freed, p))?;
-                    return Ok(Next::Freed(start, Some(deeper)));
-                }
-                passed = true;
-                flown = Some(a);
             }
             if let Some(p) = self.deep {
                 z = with_depth(&z, g, p);
-                let a = match flown {
-                    Some(a) => a,
-                    None => obj.least_at((&self.at_j, j), &z, g)?,
+                let (a, own) = match flown {
+                    Some(a) => (a, f32::NAN),
+                    None => obj.least_and_j((&self.at_j, j), &z, g)?,
                 };
+                // (Track `j` flew otherwise than at the last lift.)
+                let moved = (own - core::mem::replace(&mut last_j, own)).abs() > MOVED * own.abs();
                 if a >= self.target {
                     return Ok(Next::Deep((held, self.zj - up)));
                 }
                 if a <= last + self.slack {
-                    // The climb saturates; below track `j`'s start, a dive,
-                    // whose end is kept for where no later lift frees more
-                    // (module docs).
+                    // The climb saturates, or track `g` settles on its
+                    // own depth before its least altitude; below track
+                    // `j`'s start, a dive, whose end is kept for where no
+                    // later lift frees more (module docs).
                     let end = self.saturated(a, passed, held);
                     if up <= self.at_j.depth() {
-                        return Ok(end);
+                        return self.climb_end(obj, (z, up), end, moved && !past_freed);
                     }
                     if plateau.is_none() {
                         *plateau = Some(end);
@@ -155,6 +167,69 @@ impl<const N: usize> Lift<N> {
         Ok(Next::Nothing)
     }
 
+    /// Where the lift to `up` (m, depth `j` of `z`, after the lift `held`,
+    /// m) frees track `g` at its own depth by `freed` (m beyond the band):
+    /// the end of the lifts, or, `past_freed`, track `g`'s least altitude
+    /// at its deep depth (m; `z` left there) for the lifts to go on.
+    fn freeing<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: &mut [f32; K],
+        freed: f32,
+        (held, up): (f32, f32),
+        past_freed: bool,
+    ) -> Result<Result<Next<K>, f32>, Stop> {
+        let start = with_depth(z, self.g, self.zg + freed);
+        let Some(p) = self.deep.filter(|&p| p > self.zg + freed) else {
+            return Ok(Ok(Next::Freed(start, None)));
+        };
+        *z = with_depth(z, self.g, p);
+        let a = obj.least_at((&self.at_j, self.j), z, self.g)?;
+        if a >= self.target {
+            return Ok(Ok(Next::Both(start, (held, self.zj - up))));
+        }
+        if !past_freed {
+            let deeper = self.deepest(obj, *z, (self.zg + freed, p))?;
+            return Ok(Ok(Next::Freed(start, Some(deeper))));
+        }
+        Ok(Err(a))
+    }
+
+    /// The end of the lifts where track `g`'s least altitude rose no more
+    /// at the lift to `up` (m; `z`): `end`, or, with `far` (track `j`'s
+    /// flight moved), the far lift's where it frees track `g`.
+    fn climb_end<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        (z, up): ([f32; K], f32),
+        end: Next<K>,
+        far: bool,
+    ) -> Result<Next<K>, Stop> {
+        if let (Next::Deep(e), true) = (&end, far)
+            && let Some(f) = self.far(obj, z, up)?
+        {
+            return Ok(Next::Far(f, *e));
+        }
+        Ok(end)
+    }
+
+    /// The far lift of the module docs from the lift to `up` (m), track
+    /// `g` at its deep depth in `z`: the lifts `(held, free)` (m) between
+    /// which it frees track `g`, if it does. One flight.
+    fn far<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        up: f32,
+    ) -> Result<Option<(f32, f32)>, Stop> {
+        let far = crate::num::max(self.zj - FAR * self.band, self.lo);
+        if far >= up {
+            return Ok(None);
+        }
+        let a = obj.least_at((&self.at_j, self.j), &with_depth(&z, self.j, far), self.g)?;
+        Ok((a >= self.target).then_some((self.zj - up, self.zj - far)))
+    }
+
     /// The end of the search where track `g`'s least altitude at its deep
     /// depth `a` (m) rises no more: the start at the lift `held` (m), or,
     /// past a freeing lift (`passed`), only where `a` is within the band
@@ -167,6 +242,40 @@ impl<const N: usize> Lift<N> {
         }
     }
 
+    /// What the lifts `found` give from `z`: the lift (m) at which track
+    /// `j`'s climb saturated short of freeing track `g` at its deep
+    /// depth, if it did; and the freed start, the freed start's deepest
+    /// depth `g`, the far lift's start and the deep one (module docs),
+    /// narrowed where they are lifts.
+    pub(super) fn starts<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        found: Next<K>,
+    ) -> Result<(Option<f32>, Starts<K>), Stop> {
+        let saturated = match found {
+            Next::Deep((held, free)) | Next::Far(_, (held, free))
+                if free <= held && held >= self.band =>
+            {
+                Some(held)
+            }
+            _ => None,
+        };
+        let starts = match found {
+            Next::Freed(start, deeper) => [Some(start), deeper, None, None],
+            Next::Deep(lifts) => [None, None, None, Some(self.narrowed(obj, z, lifts)?)],
+            Next::Both(start, lifts) => {
+                [Some(start), None, None, Some(self.narrowed(obj, z, lifts)?)]
+            }
+            Next::Far(lifts, end) => {
+                let far = Some(self.narrowed(obj, z, lifts)?);
+                [None, None, far, Some(self.narrowed(obj, z, end)?)]
+            }
+            Next::Nothing => [None; 4],
+        };
+        Ok((saturated, starts))
+    }
+
     /// The start at track `g`'s deep depth (`self.deep`) with the least
     /// lift that frees it, if the lifts by doubling find one (or the climb
     /// saturates).
@@ -176,7 +285,9 @@ impl<const N: usize> Lift<N> {
         z: [f32; K],
     ) -> Result<Option<[f32; K]>, Stop> {
         Ok(match self.search(obj, z, true)? {
-            Next::Deep(lifts) | Next::Both(_, lifts) => Some(self.narrowed(obj, z, lifts)?),
+            Next::Deep(lifts) | Next::Both(_, lifts) | Next::Far(lifts, _) => {
+                Some(self.narrowed(obj, z, lifts)?)
+            }
             _ => None,
         })
     }
