@@ -923,3 +923,18 @@ fn a_raise_reaches_the_settled_depth() {
 fn a_lift_looks_past_a_plateau_where_the_track_settles() {
     horizon_within("lift_far", 1.05, 5.573_148e6);
 }
+
+/// A held track's target walked along (`check_planner.py --seed 2749
+/// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
+/// cold SQP ended with track 3 at its target, held by track 2; a lift of
+/// track 2 by the band freed only 4.3 m of track 3's least altitude (its
+/// own depth moves it 0.65 m/m there), and the line's `J` rises over the
+/// first 5 m of the lift before it falls. The line's `J` was 3.283e6 m³,
+/// 1.26× the f64 beam search's best safe plan (2.604 892e6 m³); walked
+/// two bands along track 3's target (`src/plan/lift/search.rs`), 1.124×.
+/// (The best plan lifts 43 m, where track 3's least altitude moves to
+/// another point and it flies 20 m deeper still.)
+#[test]
+fn a_held_track_s_target_is_walked_along() {
+    horizon_within("lift_walk", 1.15, 2.604_892e6);
+}

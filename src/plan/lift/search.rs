@@ -7,13 +7,20 @@ use crate::plan::bottom::deepest;
 use crate::plan::objective::{PlanObjective, Stop};
 use crate::plan::raise::{clearing, raised};
 use crate::plan::scan::with_depth;
-use crate::sim::VehicleState;
+use crate::sim::{TrackScore, VehicleState};
 
 /// Lifts tried for one track (the band, doubling).
 const LIFTS: u32 = 6;
 
 /// The far lift, in bands: the doubling's reach (module docs).
 const FAR: f32 = 32.0;
+
+/// Steps of the walk along a held track's target (module docs).
+const WALKS: u32 = 2;
+
+/// The most a walk's step deepens the held track, in what the lift freed
+/// of its least altitude.
+const REACH: f32 = 4.0;
 
 /// The relative change of track `j`'s `J` between two lifts that tells
 /// that its flight moved: its climb did not saturate.
@@ -75,14 +82,17 @@ impl<const N: usize> Lift<N> {
     /// its own depth but not at its deep one does not end the search: the
     /// lifts go on for the deep depth alone (module docs), and there is
     /// no far lift.
+    /// `first` gets track `g`'s least altitude at its own depth at the
+    /// first lift (m; unchanged where it was not flown).
     pub(super) fn search<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         z: [f32; K],
         past_freed: bool,
+        first: &mut f32,
     ) -> Result<Next<K>, Stop> {
         let mut plateau = None;
-        let next = self.lifts(obj, z, past_freed, &mut plateau)?;
+        let next = self.lifts(obj, z, (past_freed, first), &mut plateau)?;
         Ok(match (next, plateau) {
             (Next::Freed(start, _), Some(Next::Deep(l))) => Next::Both(start, l),
             (Next::Nothing, Some(end)) => end,
@@ -96,7 +106,7 @@ impl<const N: usize> Lift<N> {
         &self,
         obj: &mut PlanObjective<'_, N>,
         mut z: [f32; K],
-        past_freed: bool,
+        (past_freed, first): (bool, &mut f32),
         plateau: &mut Option<Next<K>>,
     ) -> Result<Next<K>, Stop> {
         let (j, g) = (self.j, self.g);
@@ -108,14 +118,18 @@ impl<const N: usize> Lift<N> {
         let mut last_j = f32::NAN;
         // Whether a lift freed track `g` at its own depth already.
         let mut passed = false;
-        for _ in 0..LIFTS {
+        for n in 0..LIFTS {
             let up = crate::num::max(self.zj - lift, self.lo);
             z = with_depth(&z, j, up);
             z = with_depth(&z, g, self.zg);
             let freed = if passed {
                 f32::NEG_INFINITY
             } else {
-                obj.least_at((&self.at_j, j), &z, g)? - self.target - self.band
+                let a = obj.least_at((&self.at_j, j), &z, g)?;
+                if n == 0 {
+                    *first = a;
+                }
+                a - self.target - self.band
             };
             // Track `g`'s least altitude at its deep depth this lift, where
             // the freeing branch flew it already.
@@ -276,6 +290,48 @@ impl<const N: usize> Lift<N> {
         Ok((saturated, starts))
     }
 
+    /// The walk along track `g`'s target of the module docs from `z`,
+    /// `first` track `g`'s least altitude (m) at the first lift: at most
+    /// [`WALKS`] steps, each depth `j` lifted by the band and depth `g`
+    /// deepened by the secant's reach to its target (one flight, at most
+    /// [`REACH`] times what was freed), flown whole from `head` (one
+    /// flight). The last step whose start is feasible within the band
+    /// with the horizon's `J` lower than the last's, from `sqp` (m³) on.
+    pub(super) fn walk<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        (z, first): ([f32; K], f32),
+        (head, sqp): (&[TrackScore; K], f32),
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let (j, g) = (self.j, self.g);
+        let (mut best, mut at, mut a) = (None, z, first);
+        for n in 0..WALKS {
+            let (Some(&zj), Some(&zg)) = (at.get(j), at.get(g)) else {
+                break;
+            };
+            let up = with_depth(&at, j, crate::num::max(zj - self.band, self.lo));
+            if n > 0 {
+                a = obj.least_at((&self.at_j, j), &up, g)?;
+            }
+            // What the lift freed (m), and what deepening by as much takes.
+            let freed = a - self.target;
+            if freed.is_nan() || freed <= self.slack {
+                break;
+            }
+            let fell = a - obj.least_at((&self.at_j, j), &with_depth(&up, g, zg + freed), g)?;
+            if fell.is_nan() || fell <= 0.0 {
+                break;
+            }
+            let start = with_depth(&up, g, zg + (freed * freed / fell).min(REACH * freed));
+            let (jz, v) = obj.tail_value(head, (&self.at_j, j), &start)?;
+            if v > self.band || jz.is_nan() || jz >= best.map_or(sqp, |(_, b)| b) {
+                break;
+            }
+            (best, at) = (Some((start, jz)), start);
+        }
+        Ok(best.map(|(start, _)| start))
+    }
+
     /// The start at track `g`'s deep depth (`self.deep`) with the least
     /// lift that frees it, if the lifts by doubling find one (or the climb
     /// saturates).
@@ -284,7 +340,8 @@ impl<const N: usize> Lift<N> {
         obj: &mut PlanObjective<'_, N>,
         z: [f32; K],
     ) -> Result<Option<[f32; K]>, Stop> {
-        Ok(match self.search(obj, z, true)? {
+        let mut first = f32::NAN;
+        Ok(match self.search(obj, z, true, &mut first)? {
             Next::Deep(lifts) | Next::Both(_, lifts) | Next::Far(lifts, _) => {
                 Some(self.narrowed(obj, z, lifts)?)
             }
