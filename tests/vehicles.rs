@@ -938,3 +938,23 @@ fn a_lift_looks_past_a_plateau_where_the_track_settles() {
 fn a_held_track_s_target_is_walked_along() {
     horizon_within("lift_walk", 1.15, 2.604_892e6);
 }
+
+/// A boundary beyond a flat safe side, found by the unit step's landing
+/// (`check_planner.py --seed 2960 --vehicle
+/// tools/reference/vehicles/fast.toml`, `unseen_2960_1`, track 2,
+/// constrained): the track's least altitude is set by the arrival, 9 mm
+/// above its target, down to 977.9 m, and falls 1.03 m per m beyond. The
+/// root search's unit step from the scan's unsafe end landed at 974.48 m
+/// on the flat side, and the search stopped there: `J` 3.918e5 m³, 1.078×
+/// the f64 search's best safe 3.636 05e5 m³ (977.97 m). It goes on now
+/// (`src/optim/root.rs`).
+#[test]
+fn a_unit_step_onto_a_flat_side_is_no_boundary() {
+    track_within(
+        "flat_unit",
+        &["--mode", "track"],
+        &[(0, 1080.322)],
+        1,
+        3.636_05e5,
+    );
+}

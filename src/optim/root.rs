@@ -12,14 +12,21 @@
 //! (Dowell & Jarratt 1971). Each aims at half the tolerance above 0.
 //!
 //! A margin within the tolerance ends the search only where it shows the
-//! boundary is near: a safe end the search reached by that unit step, or
-//! whose margin differs from the safe end's before. A safe side can be
-//! flat too (the least altitude set where the depth does not act yet, at
-//! whatever margin the previous track's boundary left it): a caller's safe
-//! end there, or a safe evaluation at the same margin, may lie anywhere on
-//! that side, so the search goes on, by the unit step where it lands
-//! inside the bracket, else by bisection; where two unsafe evaluations
-//! have measured the unsafe side's slope, by their secant instead.
+//! boundary is near: a safe end whose margin differs from the safe end's
+//! before. A safe side can be flat too (the least altitude set where the
+//! depth does not act yet, at whatever margin the previous track's
+//! boundary left it): a caller's safe end there, or a safe evaluation at
+//! the same margin, may lie anywhere on that side, so the search goes on,
+//! by the unit step where it lands inside the bracket, else by bisection;
+//! where two unsafe evaluations have measured the unsafe side's slope, by
+//! their secant instead. That holds for a safe end the unit step reached
+//! too: where the sloped side falls faster than a metre per metre, the
+//! unit step from the unsafe end lands short of the boundary, on the flat
+//! side at its very margin (`check_planner.py --seed 2960 --vehicle
+//! tools/reference/vehicles/fast.toml`, `unseen_2960_1` track 2,
+//! constrained: a side falling 1.03 m per m sent the step from 102 m
+//! beyond the boundary to 3.5 m short of it, where the search stopped, at
+//! 1.078× the best safe `J`).
 
 /// How far towards the unsafe end (of the bracket) a secant may land. A
 /// wide bracket whose boundary lies near its unsafe end (a long flat safe
@@ -69,8 +76,7 @@ struct Search {
     kept_good: bool,
     kept_bad: bool,
     /// Whether the safe end may lie on a flat safe side (module docs):
-    /// the caller's, or reached at its predecessor's very margin other
-    /// than by the unit step.
+    /// the caller's, or reached at its predecessor's very margin.
     flat: bool,
     /// Whether two safe evaluations have shown the safe side flat (at any
     /// margin, within the tolerance or above it).
@@ -91,8 +97,8 @@ impl Search {
     }
 
     /// Where to evaluate next, as a fraction of the way from `good` to
-    /// `bad`, and whether that is the unit step from the unsafe end.
-    fn next_t(&self, step: u32, tol: f32) -> (f32, bool) {
+    /// `bad`.
+    fn next_t(&self, step: u32, tol: f32) -> f32 {
         let (good, bad, g_good, g_bad) = (self.good, self.bad, self.g_good, self.g_bad);
         // Regula falsi, kept inside the middle 98 % of the bracket.
         let t = if g_good > 0.0 && g_bad < 0.0 && (g_good - g_bad).is_finite() {
@@ -132,10 +138,10 @@ impl Search {
                 .latest
                 .is_some_and(|((_, g1), (_, g2))| g1 < 0.0 && g2 < 0.0);
             return match (secant.filter(|_| both_bad), t_unit) {
-                (Some(ts), _) => (ts, false),
-                (None, _) if both_bad => (0.5, false),
-                (None, Some(tu)) if tu > 0.01 && tu < 0.999 => (tu, true),
-                _ => (0.5, false),
+                (Some(ts), _) => ts,
+                (None, _) if both_bad => 0.5,
+                (None, Some(tu)) if tu > 0.01 && tu < 0.999 => tu,
+                _ => 0.5,
             };
         }
         // First, and whenever the newest evaluation was unsafe and gave no
@@ -154,11 +160,11 @@ impl Search {
             .latest
             .is_some_and(|((_, g1), (_, g2))| g1 < 0.0 && g2 < 0.0);
         match (secant, t_unit) {
-            (_, Some(tu)) if step == 0 => (tu, true),
-            (Some(ts), _) => (ts, false),
-            (None, _) if both_bad => (0.5, false),
-            (None, Some(tu)) if newest_bad => (tu, true),
-            _ => (t, false),
+            (_, Some(tu)) if step == 0 => tu,
+            (Some(ts), _) => ts,
+            (None, _) if both_bad => 0.5,
+            (None, Some(tu)) if newest_bad => tu,
+            _ => t,
         }
     }
 }
@@ -206,7 +212,7 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
         if s.near(rule.tol) || libm::fabsf(s.good - s.bad) <= rule.width {
             break;
         }
-        let (t, unit) = s.next_t(step, rule.tol);
+        let t = s.next_t(step, rule.tol);
         let mid = s.good + t * (s.bad - s.good);
         let flown = eval(mid);
         let g_mid = flown.as_ref().map_or(f32::NEG_INFINITY, |(g, _)| *g);
@@ -219,7 +225,7 @@ pub(crate) fn safe_boundary<T: Copy, E, F: FnMut(f32) -> Result<(f32, T), E>>(
                     inner = Some((s.good, prev));
                 }
                 s.good = mid;
-                s.flat = !unit && g.to_bits() == s.margin.to_bits();
+                s.flat = g.to_bits() == s.margin.to_bits();
                 s.seen_flat |= s.flat;
                 s.margin = g;
                 s.g_good = g;
@@ -317,6 +323,21 @@ mod tests {
         let r = safe_boundary((866.87, Some(0.0186)), (1086.6, None), rule(), f).unwrap();
         let g = f(r.z).unwrap().0;
         assert!(r.z > 909.1 && (0.0..=0.02).contains(&g), "{} -> {g}", r.z);
+    }
+
+    /// The safe side flat at a margin within the tolerance, the unsafe
+    /// side falling faster than a metre per metre (1.034): the unit step
+    /// from the unsafe end lands 3.5 m short of the boundary, on the flat
+    /// side at its very margin, which is no boundary either. (Before:
+    /// answered there; `check_planner.py --seed 2960 --vehicle
+    /// tools/reference/vehicles/fast.toml`, `unseen_2960_1` track 2,
+    /// constrained, `J` 1.078× the best safe.)
+    #[test]
+    fn a_unit_step_onto_the_flat_side_goes_on() {
+        let f = flat_then_falling(0.007, 1.034, 977.96);
+        let r = safe_boundary((852.18, Some(0.007)), (1080.29, None), rule(), f).unwrap();
+        let g = f(r.z).unwrap().0;
+        assert!(r.z > 977.9 && (0.0..=0.02).contains(&g), "{} -> {g}", r.z);
     }
 
     /// The same on a path parameter, where a unit step of the margin does
