@@ -958,3 +958,17 @@ fn a_unit_step_onto_a_flat_side_is_no_boundary() {
         3.636_05e5,
     );
 }
+
+/// A wider look's descent that ends a step of the teeth off the basin
+/// (`check_planner.py --seed 2958 --vehicle
+/// tools/reference/vehicles/twoki.toml`, `unseen_2958_1`, track 1,
+/// unconstrained): the 2 m look from BFGS's end at 893.08 m found
+/// 891.08 m lower, the next step (887.08 m) was higher, and the
+/// parabola's vertex, 891.02 m, ended the polish at 1.0127× the f64
+/// best `J` (1.063 06e4 m³ at 890.08 m), with 890.52 m 1.1 % lower half a
+/// metre away. The first look once more from there
+/// (`src/plan/polish.rs`).
+#[test]
+fn a_wider_look_s_descent_is_looked_at_closer() {
+    track_within("polish_back", &UNCONSTRAINED, &[], 0, 1.063_06e4);
+}
