@@ -233,35 +233,18 @@ impl<const N: usize> PlanObjective<'_, N> {
     }
 
     /// Tracks `j..=g` of the horizon flown at `z` from `at_j`, the state
-    /// track `j` starts in: track `g`'s least altitude (m) and track `j`'s
-    /// `J` (m³). One flight, counted.
-    pub fn least_and_j<const K: usize>(
+    /// track `j` starts in: the scores of tracks `j` and `g`. One flight,
+    /// counted.
+    pub fn ends<const K: usize>(
         &mut self,
         (at_j, j): (&VehicleState<N>, usize),
         z: &[f32; K],
         g: usize,
-    ) -> Result<(f32, f32), Stop> {
+    ) -> Result<(TrackScore, TrackScore), Stop> {
         let used = z.get(j..=g).ok_or(Stop::Sim(SimError::TrackRange))?;
         let flown = self.fly_from::<K>((at_j, j), used)?;
         match (flown.first(), flown.get(g.saturating_sub(j))) {
-            (Some(a), Some(b)) => Ok((b.min_altitude(), a.j())),
-            _ => Err(Stop::Sim(SimError::TrackRange)),
-        }
-    }
-
-    /// Tracks `j..=g` of the horizon flown at `z` from `at_j`, the state
-    /// track `j` starts in: the least altitudes of tracks `j` and `g`, m.
-    /// One flight, counted.
-    pub fn least_pair<const K: usize>(
-        &mut self,
-        (at_j, j): (&VehicleState<N>, usize),
-        z: &[f32; K],
-        g: usize,
-    ) -> Result<(f32, f32), Stop> {
-        let used = z.get(j..=g).ok_or(Stop::Sim(SimError::TrackRange))?;
-        let flown = self.fly_from::<K>((at_j, j), used)?;
-        match (flown.first(), flown.get(g.saturating_sub(j))) {
-            (Some(a), Some(b)) => Ok((a.min_altitude(), b.min_altitude())),
+            (Some(&a), Some(&b)) => Ok((a, b)),
             _ => Err(Stop::Sim(SimError::TrackRange)),
         }
     }

@@ -280,15 +280,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // look once more (module docs).
         if out.is_none() {
             let bar = best.1 - tol.j_threshold(best.1);
-            let again = if step <= STEP {
-                [WIDE * STEP, 2.0 * WIDE * STEP]
+            let again: &[f32] = if step <= STEP {
+                &[WIDE * STEP, 2.0 * WIDE * STEP]
             } else {
-                [STEP, f32::NAN]
+                &[STEP]
             };
             let again = again
-                .into_iter()
-                .filter(|s| s.is_finite())
-                .find_map(|s| lower_side(&mut at, (best.0, s), bar).map(|p| (p, s)));
+                .iter()
+                .find_map(|&s| lower_side(&mut at, (best.0, s), bar).map(|p| (p, s)));
             if let Some(again) = again {
                 (best, out) = descend(&mut at, inside, best, again);
             }

@@ -45,11 +45,18 @@ pub(super) fn raised<const N: usize, const K: usize>(
     let Some(&zk) = z.get(k) else {
         return Ok(None);
     };
+    // Depth `k` at `up` clears the target: the deepest point toward
+    // `held` that does.
+    let cleared = |obj: &mut PlanObjective<'_, N>, (up, held): (f32, f32)| {
+        if obj.least_at((at_j, j), &with_depth(z, k, up), g)? < target {
+            return Ok(None);
+        }
+        clearing(obj, (at_j, j), (g, target), (z, (k, |d| d)), (up, held)).map(Some)
+    };
     let (mut held, mut step) = (zk, band);
     for _ in 0..RAISES {
         let up = crate::num::max(zk - step, lo);
-        if obj.least_at((at_j, j), &with_depth(z, k, up), g)? >= target {
-            let d = clearing(obj, (at_j, j), (g, target), (z, (k, |d| d)), (up, held))?;
+        if let Some(d) = cleared(obj, (up, held))? {
             return Ok(Some(d));
         }
         if up <= lo {
@@ -58,14 +65,10 @@ pub(super) fn raised<const N: usize, const K: usize>(
         (held, step) = (up, 2.0 * step);
     }
     // (The doubling's reach is the band's: 32 bands.)
-    let Some(up) = settled(obj, (k, g)).map(|d| crate::num::max(d, lo)) else {
-        return Ok(None);
-    };
-    if up < held && obj.least_at((at_j, j), &with_depth(z, k, up), g)? >= target {
-        let d = clearing(obj, (at_j, j), (g, target), (z, (k, |d| d)), (up, held))?;
-        return Ok(Some(d));
+    match settled(obj, (k, g)).map(|d| crate::num::max(d, lo)) {
+        Some(up) if up < held => cleared(obj, (up, held)),
+        _ => Ok(None),
     }
-    Ok(None)
 }
 
 /// The settled depth of horizon tracks `k..=g` (module docs): their

@@ -173,7 +173,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         for n in 0..SINKS {
             let mut down = crate::num::min(zj + sink, hi);
             let mut start = with_depth(&left, j, down);
-            let (least_j, mut least_g) = obj.least_pair(from, &start, g)?;
+            let (sj, sg) = obj.ends(from, &start, g)?;
+            let (least_j, mut least_g) = (sj.min_altitude(), sg.min_altitude());
             // Past track `j`'s own target: the deepest depth found since
             // the last sink, which cleared it, and the last start.
             let last = least_j < own;

@@ -144,7 +144,9 @@ impl<const N: usize> Lift<N> {
                 z = with_depth(&z, g, p);
                 let (a, own) = match flown {
                     Some(a) => (a, f32::NAN),
-                    None => obj.least_and_j((&self.at_j, j), &z, g)?,
+                    None => obj
+                        .ends((&self.at_j, j), &z, g)
+                        .map(|(sj, sg)| (sg.min_altitude(), sj.j()))?,
                 };
                 // (Track `j` flew otherwise than at the last lift.)
                 let moved = (own - core::mem::replace(&mut last_j, own)).abs() > MOVED * own.abs();
@@ -210,8 +212,10 @@ impl<const N: usize> Lift<N> {
     }
 
     /// The end of the lifts where track `g`'s least altitude rose no more
-    /// at the lift to `up` (m; `z`): `end`, or, with `far` (track `j`'s
-    /// flight moved), the far lift's where it frees track `g`.
+    /// at the lift to `up` (m; `z`, track `g` at its deep depth): `end`,
+    /// or, with `far` (track `j`'s flight moved), the far lift's lifts
+    /// `(held, free)` (m) where it frees track `g` (module docs; one
+    /// flight).
     fn climb_end<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -219,29 +223,14 @@ impl<const N: usize> Lift<N> {
         end: Next<K>,
         far: bool,
     ) -> Result<Next<K>, Stop> {
-        if let (Next::Deep(e), true) = (&end, far)
-            && let Some(f) = self.far(obj, z, up)?
+        let to = crate::num::max(self.zj - FAR * self.band, self.lo);
+        if let (Next::Deep(e), true) = (&end, far && to < up)
+            && obj.least_at((&self.at_j, self.j), &with_depth(&z, self.j, to), self.g)?
+                >= self.target
         {
-            return Ok(Next::Far(f, *e));
+            return Ok(Next::Far((self.zj - up, self.zj - to), *e));
         }
         Ok(end)
-    }
-
-    /// The far lift of the module docs from the lift to `up` (m), track
-    /// `g` at its deep depth in `z`: the lifts `(held, free)` (m) between
-    /// which it frees track `g`, if it does. One flight.
-    fn far<const K: usize>(
-        &self,
-        obj: &mut PlanObjective<'_, N>,
-        z: [f32; K],
-        up: f32,
-    ) -> Result<Option<(f32, f32)>, Stop> {
-        let far = crate::num::max(self.zj - FAR * self.band, self.lo);
-        if far >= up {
-            return Ok(None);
-        }
-        let a = obj.least_at((&self.at_j, self.j), &with_depth(&z, self.j, far), self.g)?;
-        Ok((a >= self.target).then_some((self.zj - up, self.zj - far)))
     }
 
     /// The end of the search where track `g`'s least altitude at its deep
