@@ -64,6 +64,22 @@ fn a_crawl_into_a_vee_is_cut_short() {
     assert!(it <= 10, "track 2: {it} iterations");
 }
 
+/// A crawl towards a jump (`check_planner.py --seed 2977 --vehicle
+/// tools/reference/vehicles/fast.toml`, `unseen_2977_2`, track 1,
+/// unconstrained): from 1 199.8 m every first trial went to the smooth
+/// side's minimum, 1 199.45 m, where `J` is 70 404 m³, about 85 m³ above
+/// the point's: `J` jumps up in between, so the vee (for a kink) has no
+/// estimate. Each trial was cut to a tenth: 11 iterations, `J` falling
+/// 2e-5 of itself each, over the checker's 10.
+/// Two such crawls in a row end the run now (`optim/bfgs.rs`), and the
+/// polish reads past the jump. The f64 best: 68 944.8 m³ (1 202.157 m).
+#[test]
+fn a_crawl_towards_a_jump_is_cut_short() {
+    let t = track_within("crawl_jump", &UNCONSTRAINED, &[], 0, 68_944.8);
+    let it = t["iterations"].as_u64().unwrap();
+    assert!(it <= 10, "track 1: {it} iterations");
+}
+
 /// A quiet tooth (`check_planner.py --seed 2418 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_2418_4`, track 3): BFGS
 /// stopped at 420.68 m, `J` 2.2957e6 m³, 9 m short of the basin, on a
