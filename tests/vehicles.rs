@@ -319,6 +319,26 @@ fn a_boundary_on_a_sawtooth_gives_way_to_the_trend() {
     assert!(h >= 60.0, "track 1: least altitude {h}");
 }
 
+/// Teeth past a boundary (`check_planner.py --seed 2933 --vehicle
+/// tools/reference/vehicles/twoki.toml`, `unseen_2933_0`, constrained
+/// track by track). Track 2's least altitude has teeth 8 cm wide and 1 cm
+/// high on a trend that crosses `h_a` (45 m) at 6 cm per metre of depth:
+/// the boundary search stopped at 581.20 m, `J` 129 232 m³, 1.0059× the
+/// f64 best safe 128 471 m³ (581.368 m), on a tooth deeper. Probes past
+/// the boundary now (`src/plan/fallback.rs`).
+#[test]
+fn teeth_past_a_boundary_are_probed() {
+    let t = track_within(
+        "boundary_teeth",
+        &["--mode", "track"],
+        &[(0, 472.420)],
+        1,
+        128_471.0,
+    );
+    let h = t["min_altitude"].as_f64().unwrap();
+    assert!(h >= 45.0, "track 2: least altitude {h}");
+}
+
 /// A plateau's restart that ended past the safe set (`check_planner.py
 /// --seed 2002 --vehicle tools/reference/vehicles/integ.toml`,
 /// `unseen_2002_7`, constrained track by track). Track 3's depth is on a

@@ -21,6 +21,12 @@ const BOUNDARY_SHARE: f32 = 0.002;
 /// ... or when the bracket is this narrow, m (see `BOUNDARY_ALTITUDE`).
 const BOUNDARY_DEPTH: f32 = 1e-3;
 
+/// The first probe past a boundary with teeth, m ([`past_teeth`]).
+const PAST_FIRST: f32 = 0.01;
+
+/// Most probes past it (the last 2^5 = 32 × the first).
+const PAST_PROBES: u32 = 6;
+
 /// A depth with its flight.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Flown<const N: usize> {
@@ -74,14 +80,54 @@ pub(super) fn boundary<const N: usize>(
         Some(f) => f,
         None => fl.fly(r.z)?,
     };
+    let at = Flown {
+        depth: r.z,
+        score,
+        next,
+    };
+    let integrates = fl.sc.vehicle().autopilot().config().depth_pid.ki > 0.0;
     Ok(Boundary {
-        at: Flown {
-            depth: r.z,
-            score,
-            next,
+        at: if integrates {
+            past_teeth(fl, at, bad.0, h_safe)
+        } else {
+            at
         },
         inner: r.inner.map(|(z, (s, _))| (z, s.j())),
     })
+}
+
+/// A boundary `at` of a least altitude with teeth (a depth loop that
+/// integrates conditionally, `polish.rs`): where the trend of the least
+/// altitude crosses `h_safe` (m) slowly, teeth past the crossing the root
+/// search found still clear it (on `check_planner.py --seed 2933
+/// --vehicle tools/reference/vehicles/twoki.toml`, `unseen_2933_0` track
+/// 2, constrained, teeth 8 cm wide and 1 cm high on a trend of 6 cm per
+/// metre: the boundary at 581.20 m, safe teeth to 581.44 m, `J` 1.0059×
+/// the best safe). Probes towards the unsafe end `bad` (m), doubling from
+/// [`PAST_FIRST`]: the lowest `J` of those that clear `h_safe`, else
+/// `at`. At most [`PAST_PROBES`] flights; a refused one ends them.
+fn past_teeth<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    at: Flown<N>,
+    bad: f32,
+    h_safe: f32,
+) -> Flown<N> {
+    let toward = bad - at.depth;
+    let (mut best, mut step) = (at, PAST_FIRST);
+    for _ in 0..PAST_PROBES {
+        if step >= libm::fabsf(toward) {
+            break;
+        }
+        let depth = at.depth + step.copysign(toward);
+        let Ok((score, next)) = fl.fly(depth) else {
+            break;
+        };
+        if score.min_altitude() >= h_safe && score.j() < best.score.j() {
+            best = Flown { depth, score, next };
+        }
+        step *= 2.0;
+    }
+    best
 }
 
 /// A warm-started single track (the last of a horizon) whose optimum
