@@ -976,6 +976,19 @@ fn a_lift_looks_past_a_plateau_where_the_track_settles() {
     horizon_within("lift_far", 1.05, 5.573_148e6);
 }
 
+/// A lift that reaches a saturated climb (`check_planner.py --seed 2984
+/// --vehicle tools/reference/vehicles/tight.toml`, `unseen_2984_5`, band
+/// 4 m): track 3 held by a ridge 200 m into it, and lifts of track 2 up to
+/// 128 m leaving its least altitude at its preferred depth still rising;
+/// the line's `J` was 1.675e7 m³, 1.44× the f64 beam search's best safe
+/// plan (1.165 796e7 m³, which lifts track 1 by 52 m and track 2 into its
+/// saturated climb). Lifted on to 512 m, the climb saturates and the lift
+/// of track 1 before it is sought (`src/plan/lift/`).
+#[test]
+fn a_lift_reaches_past_a_climb_that_still_rises() {
+    horizon_within("lift_reach", 1.05, 1.165_796e7);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of

@@ -123,6 +123,21 @@
 //! move, both lower: `unseen_3112_3` 1.024× → 0.959×; 0.7 flights a line
 //! more).
 //!
+//! The doublings reach 128 bands (eight lifts; six before round 31, 32
+//! bands). On `check_planner.py --seed 2984 --vehicle
+//! tools/reference/vehicles/tight.toml` (`unseen_2984_5`, band 4 m)
+//! track 3 was held by a ridge 200 m into it. Lifts of track 2 up to
+//! 128 m left track 3's least altitude at its preferred depth still
+//! rising (−107 m, then −62 m at the last), so the climb was never seen
+//! to saturate and the lift before a saturated one was not sought. The
+//! best plan lifts track 1 by 52 m and track 2 into its saturated climb
+//! so that track 3 flies 148 m deeper, past the ridge: the line's `J` was
+//! 1.44× the f64 search's best safe plan. With eight lifts the climb
+//! saturates at 256 m and the lift of track 1 before it makes the start:
+//! 1.0013×. On the 304 random lines of BENCHMARKS.md one other moves
+//! (`unseen_5032_2`, `tight`, 0.70×), for 2.3 flights a line (577 of
+//! them on that line); the 18 shared runs keep their plans and flights.
+//!
 //! A climb that does not saturate can leave track `g` as short as the
 //! last lift did too: the vehicle settles on track `g`'s deep depth
 //! before its least altitude, whatever the lift, until a lift so far that

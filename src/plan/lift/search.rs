@@ -9,8 +9,10 @@ use crate::plan::raise::{clearing, raised};
 use crate::plan::scan::with_depth;
 use crate::sim::{TrackScore, VehicleState};
 
-/// Lifts tried for one track (the band, doubling).
-const LIFTS: u32 = 6;
+/// Lifts tried for one track (the band, doubling): 128 bands at most,
+/// so that a climb still rising at 32 bands is seen to saturate (the
+/// lift before a saturated one, module docs).
+const LIFTS: u32 = 8;
 
 /// The far lift, in bands: the doubling's reach (module docs).
 const FAR: f32 = 32.0;
