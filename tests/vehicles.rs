@@ -15,6 +15,15 @@ use tool::{horizon_within, track_within};
 /// `plan --mode track --unconstrained`.
 const UNCONSTRAINED: [&str; 3] = ["--mode", "track", "--unconstrained"];
 
+/// Track `i` (from 0) of fixture `name`, unconstrained, after the
+/// premise: its `J` within the checker's bound of `best` (m³) and at most
+/// the checker's 10 BFGS iterations.
+fn cut_short(name: &str, premise: &[(usize, f64)], i: usize, best: f64) {
+    let t = track_within(name, &UNCONSTRAINED, premise, i, best);
+    let it = t["iterations"].as_u64().unwrap();
+    assert!(it <= 10, "track {}: {it} iterations", i + 1);
+}
+
 /// A sawtooth (`check_planner.py --seed 51`, `unseen_51_0`, track 1): `J`
 /// jumps +181 m³ every 6.5 cm of depth on a trend of +1 800 m³/m, and
 /// between jumps falls at 970 m³/m, the exact gradient's slope. BFGS
@@ -44,9 +53,7 @@ fn a_staircase_is_read_at_its_trend() {
 /// (1 111.820 m).
 #[test]
 fn a_crawl_down_a_sawtooth_is_cut_short() {
-    let t = track_within("crawl", &UNCONSTRAINED, &[], 0, 4.652_41e4);
-    let it = t["iterations"].as_u64().unwrap();
-    assert!(it <= 10, "track 1: {it} iterations");
+    cut_short("crawl", &[], 0, 4.652_41e4);
 }
 
 /// A crawl into a vee (`check_planner.py --seed 2559 --vehicle
@@ -59,9 +66,7 @@ fn a_crawl_down_a_sawtooth_is_cut_short() {
 /// The f64 best: 23 344.2 m³ (675.084 m).
 #[test]
 fn a_crawl_into_a_vee_is_cut_short() {
-    let t = track_within("vee", &UNCONSTRAINED, &[(0, 731.494)], 1, 23_344.2);
-    let it = t["iterations"].as_u64().unwrap();
-    assert!(it <= 10, "track 2: {it} iterations");
+    cut_short("vee", &[(0, 731.494)], 1, 23_344.2);
 }
 
 /// A crawl towards a jump (`check_planner.py --seed 2977 --vehicle
@@ -75,9 +80,7 @@ fn a_crawl_into_a_vee_is_cut_short() {
 /// polish reads past the jump. The f64 best: 68 944.8 m³ (1 202.157 m).
 #[test]
 fn a_crawl_towards_a_jump_is_cut_short() {
-    let t = track_within("crawl_jump", &UNCONSTRAINED, &[], 0, 68_944.8);
-    let it = t["iterations"].as_u64().unwrap();
-    assert!(it <= 10, "track 1: {it} iterations");
+    cut_short("crawl_jump", &[], 0, 68_944.8);
 }
 
 /// A polish ended on a tooth's top (`check_planner.py --seed 2792
@@ -180,9 +183,7 @@ fn a_sawtooth_falling_into_the_boundary_is_polished_to_it() {
 /// 1.097587e5 m³ (748.51 m).
 #[test]
 fn a_concave_stretch_is_walked_in_doubling_steps() {
-    let t = track_within("concave", &UNCONSTRAINED, &[(0, 725.597)], 1, 1.097_587e5);
-    let it = t["iterations"].as_u64().unwrap();
-    assert!(it <= 10, "track 2: {it} iterations");
+    cut_short("concave", &[(0, 725.597)], 1, 1.097_587e5);
 }
 
 /// Little pitch authority (`check_planner.py --seed 71 --vehicle`,
@@ -754,9 +755,7 @@ fn a_narrow_basin_beside_a_plateau_is_found() {
 /// The f64 best: 34 956.3 m³ at 525.758 m.
 #[test]
 fn a_parabola_through_a_plateau_does_not_start_the_optimizer() {
-    let t = track_within("plateau_vertex", &UNCONSTRAINED, &[], 0, 34_956.3);
-    let it = t["iterations"].as_u64().unwrap();
-    assert!(it <= 10, "track 1: {it} iterations");
+    cut_short("plateau_vertex", &[], 0, 34_956.3);
 }
 
 /// An end infeasible by less than the band starts the wide beam too

@@ -8,6 +8,7 @@ use crate::sim::{Scenario, TrackScore, VehicleState};
 
 use super::PlanError;
 use super::flights::Flights;
+use super::objective::teeth;
 use super::scan::{ScanLog, grid};
 
 /// The boundary search stops when the safe end is within this much of the
@@ -85,9 +86,8 @@ pub(super) fn boundary<const N: usize>(
         score,
         next,
     };
-    let integrates = fl.sc.vehicle().autopilot().config().depth_pid.ki > 0.0;
     Ok(Boundary {
-        at: if integrates {
+        at: if teeth(&fl.sc) {
             past_teeth(fl, at, bad.0, h_safe)
         } else {
             at

@@ -113,10 +113,9 @@ impl<const N: usize> PlanObjective<'_, N> {
         Ok(scores)
     }
 
-    /// Whether the vehicle's depth loop integrates (`ki > 0`): it does so
-    /// conditionally, and `J` has teeth (`polish.rs`).
+    /// Whether the vehicle's depth loop integrates ([`teeth`]).
     pub(super) fn teeth(&self) -> bool {
-        self.sc.vehicle().autopilot().config().depth_pid.ki > 0.0
+        teeth(&self.sc)
     }
 
     /// Whether the mission declares uncertainty (the call certifies its
@@ -412,4 +411,11 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
         let scores = self.flight(z)?;
         self.value_of(&scores)
     }
+}
+
+/// Whether the vehicle of `sc` has a depth loop that integrates (`ki >
+/// 0`): it does so conditionally, and `J` and the least altitude have
+/// teeth (`polish.rs`, `fallback.rs`).
+pub(super) fn teeth<const N: usize>(sc: &Scenario<'_, N>) -> bool {
+    sc.vehicle().autopilot().config().depth_pid.ki > 0.0
 }
