@@ -145,6 +145,19 @@ fn a_basin_between_the_wider_and_the_widest_looks_is_found() {
     track_within("polish_gap", &UNCONSTRAINED, &[(0, 500.085)], 1, 475_915.0);
 }
 
+/// A basin between the first and the wider looks (`check_planner.py
+/// --seed 2985 --vehicle tools/reference/vehicles/fast.toml`,
+/// `unseen_2985_6`, track 3, unconstrained): BFGS stalled at 868.870 m,
+/// `J` 12 254 m³, in a valley whose sides half a metre off and 2, 4 and
+/// 8 m off are all higher; a bump 0.4 m deeper (12 344 m³ at 869.2 m)
+/// hides the basin 1.2 m deeper: 1.0090× the f64 best 12 145.3 m³
+/// (870.079 m, from the tool's tracks 1 and 2). A look at 1 m finds it.
+#[test]
+fn a_basin_between_the_first_and_the_wider_looks_is_found() {
+    let premise = [(0, 787.7705), (1, 838.3684)];
+    track_within("basin_between_looks", &UNCONSTRAINED, &premise, 2, 12_145.3);
+}
+
 /// A descent from the polish's first look that ends in a dip beside the
 /// basin (`check_planner.py --seed 2807 --vehicle
 /// tools/reference/vehicles/rate.toml`, `unseen_2807_3`, track 4,
