@@ -353,6 +353,22 @@ fn teeth_past_a_boundary_are_probed() {
     assert!(h >= 45.0, "track 2: least altitude {h}");
 }
 
+/// A track after a knife edge, track by track (`check_planner.py --seed
+/// 2867 --vehicle tools/reference/vehicles/stiff.toml`, `unseen_2867_7`,
+/// constrained): track 3 ends 1.2 mm short of waypoint 3, and track 4's
+/// depth, safe in its own flight by 0.01 mm, was 3.4 cm below `h_a` from
+/// the other switch's state: reported `infeasible`, though a depth a few
+/// centimetres shallower is safe both ways. Aimed past the branch now
+/// (`src/plan/knife.rs`): safe, `constrained`, and within the checker's
+/// bound of the f64 best from one switch's state, 156 468 m³ (237.398 m).
+#[test]
+fn a_track_after_a_knife_edge_is_aimed_past_its_branch() {
+    let premise = [(2, 183.399)];
+    let t = track_within("branch_edge", &["--mode", "track"], &premise, 3, 156_468.0);
+    assert_eq!(t["safe"], true, "track 4: {t}");
+    assert_eq!(t["status"], "constrained", "track 4: {t}");
+}
+
 /// A plateau's restart that ended past the safe set (`check_planner.py
 /// --seed 2002 --vehicle tools/reference/vehicles/integ.toml`,
 /// `unseen_2002_7`, constrained track by track). Track 3's depth is on a

@@ -387,8 +387,9 @@ fn check_contract<const N: usize, const K: usize>(
     // Safe is certified; infeasible exactly when not. A certified track is
     // safe for the model; nothing uncertain is declared here, so the
     // certificate of the track alone is its nominal flight, and in
-    // track-wise or unconstrained planning that is all `safe` says (in
-    // horizon mode the continuation must certify too).
+    // unconstrained planning that is all `safe` says (constrained, the
+    // other switch of a knife edge too, and in horizon mode the
+    // continuation must certify too).
     assert_eq!(plan.safe, plan.status != PlanStatus::Infeasible, "{plan:?}");
     // (A single track on a floor set by its arrival, over `h_a` but
     // inside the margin, is certified against that floor: `single.rs`.)
@@ -409,8 +410,9 @@ fn check_contract<const N: usize, const K: usize>(
         plan.certified_min_altitude,
         plan.min_altitude
     );
-    let horizon_constrained = cfg.mode == Mode::Horizon && cfg.constrained;
-    if !horizon_constrained && !plan.safe {
+    // (Constrained, the certificate also flies a knife edge's other switch
+    // after an earlier track ended on it, in either mode: `knife.rs`.)
+    if !cfg.constrained && !plan.safe {
         assert!(plan.min_altitude < h_safe, "{plan:?}");
     }
     assert!(

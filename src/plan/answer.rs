@@ -21,7 +21,9 @@ pub struct Plan<const N: usize> {
     /// nominal model when nothing is declared) the minimum altitude is at
     /// least `h_a` plus the safety margin on this track and, in horizon
     /// mode, with [`crate::Planner::continuation`] to the end of the line
-    /// (§11).
+    /// (§11). Constrained, with one vehicle world, where an earlier
+    /// committed track ended on its waypoint's knife edge, from the state
+    /// the other switch reaches too (`knife.rs`).
     pub safe: bool,
     /// Predicted `J` of the track flown at [`Plan::depth`], m³.
     pub j: f32,

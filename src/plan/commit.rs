@@ -100,7 +100,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             &flown.next,
             (only_nominal, lazy, &mut flights),
         );
-        if guaranteed {
+        // (Track by track too, constrained: the next track is aimed past
+        // the branch, `knife.rs`.)
+        if self.cfg.constrained {
             self.branch_off_the_edge(sc, (state, track), &flown, &mut flights);
         }
         let safe = chosen.cert.all >= cand.h_safe;

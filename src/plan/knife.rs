@@ -49,6 +49,20 @@
 //! it leaves that state in the tube as a branch, flown by every later
 //! certificate ([`Planner::branch_off_the_edge`]).
 //!
+//! Track by track, constrained, the committed depth's branch is kept too
+//! (the tool's line certificate flies the other switch as well,
+//! `certify_line`), and the next track's candidate is aimed past it
+//! ([`Planner::raised_past_the_branch`]). On `check_planner.py --seed 2867
+//! --vehicle tools/reference/vehicles/stiff.toml`, `unseen_2867_7`, track
+//! 3 ended 1.2 mm short of waypoint 3 and could not move (its sample moves
+//! 1.6 cm per metre of depth: 0.33 m shallower, past [`MOST`], or 0.17 m
+//! deeper, below `h_a`); track 4's candidate cleared `h_a + m_s` by
+//! 0.01 mm in its own flight and by −3.4 cm from the other switch's
+//! state, and the line was reported `infeasible` there although a depth
+//! 7 cm shallower is safe both ways. Aimed past the branch: 60.038 m in
+//! its own flight, `constrained`, `J` 1.0041× the f64 best from one
+//! switch's state.
+//!
 //! In horizon mode, constrained, a call may commit the previous call's
 //! continuation instead of its candidate (`commit.rs`): where that
 //! continuation's first depth is on the edge and the candidate is not,
@@ -73,14 +87,14 @@
 use crate::model::ProfileView;
 use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, World, offset};
 
-use super::Planner;
-use super::candidate::Candidate;
+use super::candidate::{Candidate, boundary_tolerance};
 use super::certify::ALL;
 use super::chosen::Chosen;
 use super::fallback::Flown;
 use super::flights::Flights;
 use super::planner::MAX_TRACKS;
 use super::scan::search_box;
+use super::{Mode, Planner};
 
 /// First probe, m of depth.
 const PROBE: f32 = 5e-3;
@@ -187,6 +201,50 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         {
             self.tube.branch(World::nominal(sc.vehicle()), &other);
         }
+    }
+
+    /// Track by track, constrained and unbudgeted, with nothing declared:
+    /// where the track before ended on its waypoint's knife edge (the
+    /// tube holds its branch at this track, [`Planner::branch_off_the_edge`])
+    /// and the candidate `c` clears `h_safe` in its own flight but not
+    /// from the other switch's state, raises the track's gap (`gaps.rs`)
+    /// by the branch's shortfall and a tenth of a boundary tolerance, and
+    /// returns the certificate's flights (two): the caller aims the
+    /// candidate again, at most three times (`planner.rs`, module docs).
+    /// `None` where nothing is to be raised. Not inlined: its frame stays
+    /// off the candidate's stack.
+    #[inline(never)]
+    pub(super) fn raised_past_the_branch(
+        &mut self,
+        sc: &Scenario<'_, N>,
+        state: &VehicleState<N>,
+        track: usize,
+        c: &Candidate<N>,
+    ) -> Option<u32> {
+        let m = sc.mission();
+        let wanted = self.cfg.mode == Mode::TrackWise
+            && self.cfg.constrained
+            && self.budget.limit == u32::MAX
+            && m.uncertainty().is_none()
+            && self.tube.branched_at(state, track);
+        let h_safe = m.min_altitude() + self.cfg.safety_margin;
+        if !wanted || c.flown.score.min_altitude() < h_safe {
+            return None;
+        }
+        // (Nothing declared: the map is the certification bottom.)
+        let bottom = sc.profile();
+        let mut flights = 0_u32;
+        self.tube
+            .materialize((sc, bottom), (state, track), (ALL, &mut flights));
+        let at = (f32::NEG_INFINITY, &mut flights);
+        let short = h_safe - self.tube.certify(sc, bottom, &[c.flown.depth], at).all;
+        // (A failed flight's certificate is −∞: nothing to aim at.)
+        if short <= 0.0 || !short.is_finite() {
+            return None;
+        }
+        let more = 0.1 * boundary_tolerance(m.reference_altitude() - m.min_altitude());
+        *self.gaps.get_mut(track)? += short + more;
+        Some(flights)
     }
 
     /// Under declared motion, where the previous call's continuation,

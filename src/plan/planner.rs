@@ -9,6 +9,10 @@ use super::budget::Budget;
 use super::certify::{Certificate, Tube};
 use super::{Plan, PlanError, PlannerConfig};
 
+/// Most candidates of one call aimed again past a knife edge's branch
+/// (`knife.rs`).
+const BRANCH_ROUNDS: u32 = 3;
+
 pub use super::certify::MAX_TRACKS;
 
 /// A receding-horizon or track-wise planner of up to `K` tracks at a time,
@@ -196,7 +200,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.plan_within(sc, state, track, self.cfg.max_evaluations)
     }
 
-    /// [`Planner::plan`] without a flight budget: the candidate, then the
+    /// [`Planner::plan`] without a flight budget: the candidate (track by
+    /// track after a knife edge, aimed again past the other switch's
+    /// branch, `knife.rs`, every candidate's flights counted), then the
     /// commit. Not inlined: its candidate is not on the stack of a
     /// budgeted call.
     #[inline(never)]
@@ -208,7 +214,18 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<Plan<N>, PlanError> {
         self.budget = Budget::NONE;
         self.tube.set_branch_cap(u32::MAX);
-        let cand = self.candidate(sc, state, track)?;
+        let mut cand = self.candidate(sc, state, track)?;
+        let mut spent = 0_u32;
+        for _ in 0..BRANCH_ROUNDS {
+            let Some(flights) = self.raised_past_the_branch(sc, state, track, &cand) else {
+                break;
+            };
+            spent = spent
+                .saturating_add(flights)
+                .saturating_add(cand.evaluations);
+            cand = self.candidate(sc, state, track)?;
+        }
+        cand.evaluations = cand.evaluations.saturating_add(spent);
         self.commit(sc, state, track, &cand)
     }
 }

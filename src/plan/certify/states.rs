@@ -141,6 +141,13 @@ impl<const N: usize> Tube<N> {
         }
     }
 
+    /// Whether the tube holds a knife edge's branch ([`Tube::branch`]) at
+    /// the start of `track`, its nominal world at `state`: the state the
+    /// last commit predicted.
+    pub fn branched_at(&self, state: &VehicleState<N>, track: usize) -> bool {
+        self.branches > 0 && self.at() == track && self.nominal.as_ref() == Some(state)
+    }
+
     /// Drops the branch worlds.
     fn forget_branches(&mut self) {
         let declared = self.worlds.len().saturating_sub(self.branches);
