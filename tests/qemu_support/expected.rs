@@ -146,7 +146,7 @@ pub const TRACKWISE_K1: [TrackPlan; 5] = [
         min_altitude: f32::from_bits(0x427fbc62) /* 63.933968 */,
         objective: f32::from_bits(0x483b0b7d) /* 191533.95 */,
         iterations: 1,
-        evaluations: 18,
+        evaluations: 20,
         history_len: 2,
         history_hash: 0x3c313c75,
         next_x: f32::from_bits(0x455c525b) /* 3525.1472 */,
