@@ -79,9 +79,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut c = self.candidate_aimed(sc, state, track)?;
         // (What the commit certifies against: the certified altitude, or
         // a single track's floor set by its arrival, `single.rs`.)
-        c.h_safe = c
-            .h_safe
-            .min(sc.mission().min_altitude() + self.cfg.safety_margin);
+        c.h_safe = c.h_safe.min(self.cfg.certified_altitude(sc.mission()));
         self.off_the_edge(sc, state, track, &mut c);
         Ok(c)
     }
@@ -447,7 +445,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             warm,
             mu,
             bounds: search_box::<N, K>(sc, state, track, h),
-            h_safe: sc.mission().min_altitude() + self.cfg.safety_margin,
+            h_safe: self.cfg.certified_altitude(sc.mission()),
         })
     }
 

@@ -3,6 +3,7 @@
 
 use core::fmt;
 
+use crate::model::Mission;
 use crate::optim::{BfgsConfig, OptimConfigError};
 
 /// Which optimizer runs.
@@ -119,6 +120,12 @@ impl Default for PlannerConfig {
 }
 
 impl PlannerConfig {
+    /// The certified altitude `h_a + m_s` of mission `m`, m: what a safe
+    /// plan's least altitude clears (`safety_margin`).
+    pub(super) fn certified_altitude(&self, m: &Mission) -> f32 {
+        m.min_altitude() + self.safety_margin
+    }
+
     /// `Ok` when every setting is in range, else the first that is not.
     ///
     /// # Errors

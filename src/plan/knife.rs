@@ -203,7 +203,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
     }
 
-    /// Track by track, constrained and unbudgeted, with nothing declared:
+    /// Track by track, constrained, with nothing declared (called by the
+    /// unbudgeted call alone, `planner.rs`: a budgeted call keeps no
+    /// branch):
     /// where the track before ended on its waypoint's knife edge (the
     /// tube holds its branch at this track, [`Planner::branch_off_the_edge`])
     /// and the candidate `c` clears `h_safe` in its own flight but not
@@ -224,10 +226,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let m = sc.mission();
         let wanted = self.cfg.mode == Mode::TrackWise
             && self.cfg.constrained
-            && self.budget.limit == u32::MAX
             && m.uncertainty().is_none()
             && self.tube.branched_at(state, track);
-        let h_safe = m.min_altitude() + self.cfg.safety_margin;
+        let h_safe = self.cfg.certified_altitude(m);
         if !wanted || c.flown.score.min_altitude() < h_safe {
             return None;
         }

@@ -15,14 +15,14 @@
 //! optimizer's end, a step of [`STEP`] to each side (plain flights); if one
 //! is lower by more than the stopping threshold, steps doubling that way
 //! while `J` falls, then the vertex of the parabola through the last three
-//! points. Where neither side is lower, a wider look at [`WIDE`] steps
-//! each side, doubling from there in the same way: on `check_planner.py
+//! points. Where neither side is lower, a wider look at four steps
+//! each side ([`LOOKS`]), doubling from there in the same way: on `check_planner.py
 //! --seed 2402 --vehicle tools/reference/vehicles/rate.toml`,
 //! `unseen_2402_0` track 4, unconstrained, a bump of the teeth 0.3 m wide
 //! and 0.3 % high held BFGS and both half-metre sides above its end,
 //! 1.75 m short of the basin (1.040× the best `J`, a small `J`); the
 //! wider look, 1.001×. Where that too finds nothing, a widest look at
-//! [`WIDE`]² steps: on `check_planner.py --seed 2560 --vehicle
+//! sixteen steps: on `check_planner.py --seed 2560 --vehicle
 //! tools/reference/vehicles/rate.toml`, `unseen_2560_6` track 5,
 //! unconstrained, BFGS ended in a dip of `J`'s wiggles with a bump 2.5 m
 //! to its deeper side and the basin 5.4 m away (1.0052× the best `J`);
@@ -158,11 +158,10 @@ const STEP: f32 = 0.5;
 /// polish to run.
 const SHARE: f32 = 1e-4;
 
-/// The wider look's step, in first steps; the widest look's is its
-/// square. A look at twice the first step comes before it, and one at
-/// twice the wider's between the wider and the widest: the looks double
-/// from the first to the widest.
-const WIDE: f32 = 4.0;
+/// The looks' steps, m, each side of the optimizer's end, in order: the
+/// first ([`STEP`]), then doubling to the widest, sixteen first steps
+/// (the wider look is the third, four first steps; module docs).
+const LOOKS: [f32; 5] = [STEP, 2.0 * STEP, 4.0 * STEP, 8.0 * STEP, 16.0 * STEP];
 
 /// The settling's first step, m: a fraction of a tooth's width
 /// (centimetres).
@@ -297,16 +296,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 .flatten()
         };
         // Each side at the first step, then, where neither is lower, at
-        // twice it, the wider look's, twice that, then the widest's (a
-        // bump of the teeth, or of `J`'s wiggles, can hide the basin).
-        let looks = [
-            STEP,
-            2.0 * STEP,
-            WIDE * STEP,
-            2.0 * WIDE * STEP,
-            WIDE * WIDE * STEP,
-        ];
-        let Some((first, step)) = looks
+        // each wider look in turn (a bump of the teeth, or of `J`'s
+        // wiggles, can hide the basin).
+        let Some((first, step)) = LOOKS
             .into_iter()
             .find_map(|s| lower_side(&mut at, (z0, s), bar).map(|p| (p, s)))
         else {
@@ -319,8 +311,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // look once more (module docs).
         if out.is_none() {
             let bar = best.1 - tol.j_threshold(best.1);
+            let [.., wider, twice, _] = LOOKS;
             let again: &[f32] = if step <= STEP {
-                &[WIDE * STEP, 2.0 * WIDE * STEP]
+                &[wider, twice]
             } else {
                 &[STEP]
             };

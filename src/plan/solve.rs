@@ -267,7 +267,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // Another stage only while the optimum is below the certified
         // altitude `h_a + m_s`: a violation of the penalty altitude
         // `h_a + m_p` alone is what the margin is there to absorb.
-        let h_safe = obj.sc.mission().min_altitude() + self.cfg.safety_margin;
+        let h_safe = self.cfg.certified_altitude(obj.sc.mission());
         while obj.mu > 0.0
             && obj.mu < max_mu
             && obj.last_violation > 0.0
@@ -358,7 +358,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return;
         }
         let m = *obj.sc.mission();
-        let h_safe = m.min_altitude() + self.cfg.safety_margin;
+        let h_safe = self.cfg.certified_altitude(&m);
         let band = obj.sc.penalty_altitude() + self.cfg.penalty_margin;
         let rule = boundary_rule(&m, self.cfg.bisection_steps);
         let tol = rule.tol;
