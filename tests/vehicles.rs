@@ -1017,6 +1017,20 @@ fn a_lift_reaches_past_a_climb_that_still_rises() {
     horizon_within("lift_reach", 1.05, 1.165_796e7);
 }
 
+/// A lift that the restart takes back on teeth (`check_planner.py --seed
+/// 2991 --vehicle tools/reference/vehicles/twoki.toml`, `unseen_2991_3`):
+/// the lift of track 1 by the band (15 m) freed track 2 to 1 135.5 m, and
+/// the SQP restarted from there went back to track 1 at 1 040.76 m: track
+/// 2's least altitude has teeth in track 1's depth, and a tooth's slope
+/// (+0.19 m/m) has the sign opposite to the trend's (−0.35 m/m). The line's
+/// `J` was 2.440e6 m³, 1.137× the f64 beam search's best safe plan
+/// (2.145 956e6 m³: track 1 at 1 030 m, track 2 at 1 127.7 m). The
+/// restart is made again with the lifted depth held (`src/plan/lift/`).
+#[test]
+fn a_lift_is_held_where_the_restart_takes_it_back() {
+    horizon_within("lift_held", 1.05, 2.145_956e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of
