@@ -1031,6 +1031,19 @@ fn a_lift_is_held_where_the_restart_takes_it_back() {
     horizon_within("lift_held", 1.05, 2.145_956e6);
 }
 
+/// A later depth stuck above its target on teeth (`check_planner.py
+/// --seed 2993 --vehicle tools/reference/vehicles/twoki.toml`,
+/// `unseen_2993_1`): the cold call ended with track 2 4.4 m above its
+/// target and `∂J/∂z_2` = −1.5e4 m², where it could fly 10 m deeper, and
+/// the first depth's polish took track 1 deeper into the room that left:
+/// the line's `J` 1.376e6 m³, 1.113× the f64 beam search's best safe
+/// plan (1.236 588e6 m³). The later depths are polished first now
+/// (`src/plan/polish.rs`): 1.069×.
+#[test]
+fn a_later_depth_stuck_above_its_target_is_polished() {
+    horizon_within("later_stuck", 1.08, 1.236_588e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of

@@ -125,6 +125,27 @@
 //! where the depth loop integrates: the line went from 1.50× to 1.116×
 //! the best safe `J` (track 1 at 564.6 m; the best plan's 568.0 m).
 //!
+//! The later depths can be stuck the same way: free of their targets,
+//! with a gradient that promises much, where the SQP's steps are cut to
+//! slivers by the teeth and a row's kink. On `check_planner.py --seed
+//! 2993 --vehicle tools/reference/vehicles/twoki.toml`
+//! (`unseen_2993_1`) the cold call ended with track 2 at 1 331.8 m, 4.4 m
+//! above its target with `∂J/∂z_2` = −1.5e4 m², where it could fly 10 m
+//! deeper; the first depth's polish then took track 1 5 m deeper, which
+//! that shallow track 2 allowed, and the line was 1.113× the f64 search's
+//! best safe plan. So before the first depth, each later depth whose track
+//! clears its target by more than [`FREE`] of the band, and whose
+//! gradient promises more than [`SHARE`] of `J` over [`STEP`], is
+//! polished the same way, the other depths held, against the same
+//! floors: 1.069× (track 2's descent stops at 1 335.2 m, where track 4's
+//! least altitude, at its target, wanders below its floor with the teeth;
+//! the best plan flies track 4 3.5 m shallower). On the 304 random lines
+//! of BENCHMARKS.md 14 move in horizon mode, 10 lower (by up to 0.17 %)
+//! and 4 higher (by up to 0.24 %: `unseen_5034_2`, `integ`, 1.0440× →
+//! 1.0466× the f64 best), 2.95 flights a line more; the default vehicle's
+//! depth loop does not integrate, and the 18 shared runs keep their plans
+//! and flights.
+//!
 //! A look's descent reads the trend and ends anywhere on a tooth, up to
 //! a tooth's height above its bottom. Where `J` is small that height is a
 //! share of it: on `check_planner.py --seed 2792 --vehicle
@@ -144,6 +165,7 @@
 use crate::num::min;
 use crate::optim::root;
 use crate::optim::{Bounds, First};
+use crate::sim::TrackScore;
 
 use super::Planner;
 use super::fallback::boundary_rule;
@@ -169,6 +191,10 @@ const TOOTH: f32 = 0.01;
 
 /// Most doublings of the step.
 const DOUBLINGS: u32 = 8;
+
+/// The share of the band `h_r − h_a` by which a later track clears its
+/// target for its depth to count as free (module docs).
+const FREE: f32 = 0.05;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The polish of the module docs on the workspace's single track, in
@@ -202,7 +228,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !(libm::fabsf(g0) * STEP > share || fell > share || obj.teeth()) {
             return;
         }
-        self.polish_from(obj, (lo, hi), Clear::First(h_safe), (z0, j0));
+        self.polish_from(obj, (0, lo, hi), Clear::First(h_safe), (z0, j0));
     }
 
     /// The horizon's committed (first) depth polished as a single track's
@@ -244,7 +270,45 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         for (t, (floor, s)) in floors.iter_mut().zip(&end).enumerate().take(obj.count) {
             *floor = min(s.min_altitude(), obj.target_of(t)) - tol;
         }
-        self.polish_from(obj, (lo, hi), Clear::Floors(floors), (z0, j0));
+        let clear = Clear::Floors(floors);
+        let mut j0 = j0;
+        for i in 1..h.min(obj.count) {
+            if self.stuck_later(obj, (i, bounds), &end, tol)
+                && let (Some(&zi), Some(&lo), Some(&hi)) =
+                    (self.work.z.get(i), bounds.lo.get(i), bounds.hi.get(i))
+                && self.polish_from(obj, (i, lo, hi), clear, (zi, j0))
+            {
+                j0 = self.work.j;
+            }
+        }
+        self.polish_from(obj, (0, lo, hi), clear, (z0, j0));
+    }
+
+    /// Whether later depth `i` of the SQP's end (its flight `end`) is
+    /// stuck (module docs): its track clears its target by more than
+    /// [`FREE`] of the band `h_r − h_a` (and `tol`, m), and its gradient
+    /// predicts more than [`SHARE`] of `J` over [`STEP`].
+    fn stuck_later(
+        &self,
+        obj: &PlanObjective<'_, N>,
+        (i, bounds): (usize, &Bounds<K>),
+        end: &[TrackScore; K],
+        tol: f32,
+    ) -> bool {
+        let m = obj.sc.mission();
+        let slack = tol.max(FREE * (m.reference_altitude() - m.min_altitude()));
+        let w = &self.work;
+        let (Some(s), Some(&g), Some(&lo), Some(&hi)) = (
+            end.get(i),
+            w.gradient.get(i),
+            bounds.lo.get(i),
+            bounds.hi.get(i),
+        ) else {
+            return false;
+        };
+        lo < hi
+            && s.min_altitude() > obj.target_of(i) + slack
+            && libm::fabsf(g) * STEP > SHARE * libm::fabsf(w.j)
     }
 
     /// The polish's search from a constrained track's boundary `(z, J)`
@@ -267,20 +331,20 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         obj.tripped = None;
         let guard = obj.guard;
-        self.polish_from(obj, (lo, hi), Clear::First(guard), (z, j))
+        self.polish_from(obj, (0, lo, hi), Clear::First(guard), (z, j))
     }
 
-    /// The polish's search from `(z0, J0)` (m, m³), the workspace's first
-    /// track at `z0`, in `[lo, hi]` (m), its points clearing `clear`:
-    /// whatever the gradient says. Moves
-    /// the workspace to the lowest point found below the stopping
-    /// threshold; whether it moved. Out of line: one copy for both
-    /// callers.
+    /// The polish's search of depth `i` from `(z0, J0)` (m, m³), the
+    /// workspace's depth `i` at `z0`, in `[lo, hi]` (m), the other depths
+    /// held, its points clearing `clear`: whatever the gradient says.
+    /// Moves the workspace to the lowest point found below the stopping
+    /// threshold; whether it moved. Out of line: one copy for every
+    /// caller.
     #[inline(never)]
     pub(super) fn polish_from(
         &mut self,
         obj: &mut PlanObjective<'_, N>,
-        (lo, hi): (f32, f32),
+        (i, lo, hi): (usize, f32, f32),
         clear: Clear<K>,
         (z0, j0): (f32, f32),
     ) -> bool {
@@ -292,7 +356,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let mut at = |z: f32| {
             let z = inside(z);
             (z.to_bits() != z0.to_bits())
-                .then(|| flown_at(obj, (&base, z), clear))
+                .then(|| flown_at(obj, (&base, i, z), clear))
                 .flatten()
         };
         // Each side at the first step, then, where neither is lower, at
@@ -336,13 +400,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // boundary between them.
         if let Some(z) = out
             && let Some(p) =
-                boundary_toward(obj, (&base, best.0, z), clear, self.cfg.bisection_steps)
+                boundary_toward(obj, (&base, i, best.0, z), clear, self.cfg.bisection_steps)
             && p.1 < best.1
         {
             best = p;
         }
         let w = &mut self.work;
-        if let Some(z) = w.z.first_mut() {
+        if let Some(z) = w.z.get_mut(i) {
             *z = best.0;
         }
         w.j = best.1;
@@ -413,18 +477,18 @@ pub(super) enum Clear<const K: usize> {
     Floors([f32; K]),
 }
 
-/// `(z, J)` of the horizon `base` flown with its first depth at `z` (m),
+/// `(z, J)` of the horizon `base` flown with its depth `i` at `z` (m),
 /// when its flight flies and clears `clear`. One plain flight.
 fn flown_at<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
-    (base, z): (&[f32; K], f32),
+    (base, i, z): (&[f32; K], usize, f32),
     clear: Clear<K>,
 ) -> Option<(f32, f32)> {
-    let (j, margin) = margin_at(obj, (base, z), clear)?;
+    let (j, margin) = margin_at(obj, (base, i, z), clear)?;
     (margin >= 0.0).then_some((z, j))
 }
 
-/// `(J, margin)` (m³, m) of the horizon `base` flown with its first depth
+/// `(J, margin)` (m³, m) of the horizon `base` flown with its depth `i`
 /// at `z` (m), when its flight flies to a finite `J`: the margin is the
 /// least of its clearances of `clear` (infinite where nothing is to be
 /// cleared). One plain flight; out of line, so that the polish holds one
@@ -432,11 +496,11 @@ fn flown_at<const N: usize, const K: usize>(
 #[inline(never)]
 fn margin_at<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
-    (base, z): (&[f32; K], f32),
+    (base, i, z): (&[f32; K], usize, f32),
     clear: Clear<K>,
 ) -> Option<(f32, f32)> {
     let mut zz = *base;
-    *zz.first_mut()? = z;
+    *zz.get_mut(i)? = z;
     let (j, margin) = match clear {
         Clear::First(h_safe) => {
             let (j, least, _) = horizon_flight(obj, &zz).ok()?;
@@ -453,15 +517,15 @@ fn margin_at<const N: usize, const K: usize>(
     (j.is_finite() && !margin.is_nan()).then_some((j, margin))
 }
 
-/// The safe end of the boundary between the polish's lowest point `at`
-/// (m), which clears `clear`, and the next step's `out` (m), which did
-/// not, with its `J` (m³): [`crate::optim::root`] on the margin of
+/// The safe end of the boundary, in depth `i` of `base`, between the
+/// polish's lowest point `at` (m), which clears `clear`, and the next
+/// step's `out` (m), which did not, with its `J` (m³): [`crate::optim::root`] on the margin of
 /// [`margin_at`] (a point that does not fly counts as outside), stopped
 /// by the boundary searches' rule in at most `steps` flights. None where
 /// nothing is to be cleared or the search did not move.
 fn boundary_toward<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
-    (base, at, out): (&[f32; K], f32, f32),
+    (base, i, at, out): (&[f32; K], usize, f32, f32),
     clear: Clear<K>,
     steps: u32,
 ) -> Option<(f32, f32)> {
@@ -470,7 +534,7 @@ fn boundary_toward<const N: usize, const K: usize>(
     }
     let rule = boundary_rule(obj.sc.mission(), steps);
     let r = root::safe_boundary((at, None), (out, None), rule, |z| {
-        margin_at(obj, (base, z), clear)
+        margin_at(obj, (base, i, z), clear)
             .map(|(j, margin)| (margin, j))
             .ok_or(())
     })
