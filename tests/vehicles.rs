@@ -1044,6 +1044,19 @@ fn a_later_depth_stuck_above_its_target_is_polished() {
     horizon_within("later_stuck", 1.08, 1.236_588e6);
 }
 
+/// A sink through a saturated dive (`check_planner.py --seed 3004
+/// --vehicle tools/reference/vehicles/fast.toml`, `unseen_3004_0`):
+/// track 1 flew 4 m above its target at 403.8 m, held by track 3 through
+/// track 2's dive at the pitch limit; the best safe plan sinks track 1
+/// 81 m and raises track 2 70 m and track 3 1.5 m, which no single raise
+/// does. The line's `J` was 6.049e6 m³, 4.77× the f64 beam search's best
+/// safe plan (1.268 637e6 m³). The dive's depth is raised with the sink
+/// now (`src/plan/sink.rs`).
+#[test]
+fn a_sink_through_a_saturated_dive_raises_the_dive_too() {
+    horizon_within("sink_carried", 1.05, 1.268_637e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of
