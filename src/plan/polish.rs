@@ -519,10 +519,11 @@ fn margin_at<const N: usize, const K: usize>(
 
 /// The safe end of the boundary, in depth `i` of `base`, between the
 /// polish's lowest point `at` (m), which clears `clear`, and the next
-/// step's `out` (m), which did not, with its `J` (m³): [`crate::optim::root`] on the margin of
-/// [`margin_at`] (a point that does not fly counts as outside), stopped
-/// by the boundary searches' rule in at most `steps` flights. None where
-/// nothing is to be cleared or the search did not move.
+/// step's `out` (m), which did not, with its `J` (m³):
+/// [`crate::optim::root`] on the margin of [`margin_at`] (a point that
+/// does not fly counts as outside), stopped by the boundary searches'
+/// rule in at most `steps` flights. None where nothing is to be cleared
+/// or the search did not move.
 fn boundary_toward<const N: usize, const K: usize>(
     obj: &mut PlanObjective<'_, N>,
     (base, i, at, out): (&[f32; K], usize, f32, f32),

@@ -189,12 +189,18 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // with the sink (module docs).
         let shifted = j.saturating_add(1);
         let carried = shifted < g && self.work.gradient.get(shifted).is_some_and(|&d| d == 0.0);
+        let sunk = |from: &[f32; K], down: f32| {
+            let start = with_depth(from, j, down);
+            match (carried, z.get(shifted), bounds.lo.get(shifted)) {
+                (true, Some(&zs), Some(&lo)) => {
+                    with_depth(&start, shifted, crate::num::max(zs - (down - zj), lo))
+                }
+                _ => start,
+            }
+        };
         for n in 0..SINKS {
             let mut down = crate::num::min(zj + sink, hi);
-            let mut start = with_depth(&left, j, down);
-            if carried && let (Some(&zs), Some(&lo)) = (z.get(shifted), bounds.lo.get(shifted)) {
-                start = with_depth(&start, shifted, crate::num::max(zs - (down - zj), lo));
-            }
+            let mut start = sunk(&left, down);
             let (sj, sg) = obj.ends(from, &start, g)?;
             let (least_j, mut least_g) = (sj.min_altitude(), sg.min_altitude());
             // Past track `j`'s own target: the deepest depth found since
@@ -206,7 +212,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 }
                 let cleared = crate::num::min(zj + 0.5 * sink, hi);
                 down = clearing(obj, from, (j, own), (&start, (j, |d| d)), (cleared, down))?;
-                start = with_depth(&left, j, down);
+                start = sunk(&left, down);
                 least_g = obj.least_at(from, &start, g)?;
             }
             let (mut value, mut most) = (None, band);

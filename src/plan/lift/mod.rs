@@ -337,10 +337,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         iterations
     }
 
-    /// Where the depth loop integrates and the start `z`'s horizon `J`
-    /// is below the SQP's (one plain flight): `bounds` with the depths
-    /// before track `g` held at `z`'s, for a restart that cannot take the
-    /// lift back (module docs).
+    /// For the lift of the committed depth (`g` is 1), where the depth
+    /// loop integrates and the start `z`'s horizon `J` is below the SQP's
+    /// (one plain flight): `bounds` with the depths before track `g` (the
+    /// first) held at `z`'s, for a restart that cannot take the lift back
+    /// (module docs).
     fn lifts_held(
         &self,
         obj: &mut PlanObjective<'_, N>,
