@@ -255,7 +255,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         ((from, head), (target, band)): (Tail<'_, N, K>, (f32, f32)),
         (start, (k, g)): (&[f32; K], (usize, usize)),
         bounds: &Bounds<K>,
-    ) -> Result<Option<([f32; K], usize, (f32, f32))>, Stop> {
+    ) -> Result<Option<Raised<K>>, Stop> {
         let raise = (from, (target, band));
         let Some((moved, d)) = raised_before(obj, raise, (start, (k, g)), bounds)? else {
             return Ok(None);
@@ -277,6 +277,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         Ok(Some((raised, moved, jz)))
     }
 }
+
+/// A raised start, the depth raised and the start's `(J, v)` (m³, m).
+type Raised<const K: usize> = ([f32; K], usize, (f32, f32));
 
 /// Where a sink's tail is flown from: the state track `j` starts in and
 /// `j`, and the scores of the tracks before it.
