@@ -240,9 +240,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// gradient is the tooth's slope, and an active row's gradient a
     /// tooth's too, so the SQP can converge where the trend of `J` still
     /// falls steeply into the safe set (and the later tracks' least
-    /// altitudes wander by millimetres with the teeth). One flight to
-    /// check the end, two or more for the polish. Not under declared
-    /// uncertainty.
+    /// altitudes wander by millimetres with the teeth). Before it, each
+    /// later depth stuck above its target ([`Planner::stuck_later`]) is
+    /// polished the same way. One flight to check the end, two or more
+    /// for each polish. Not under declared uncertainty.
     #[inline(never)]
     pub(super) fn polish_first(
         &mut self,

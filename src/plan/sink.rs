@@ -162,9 +162,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The start of the module docs for earlier track `j` held by later
     /// track `g`: the sink of depth `j` whose start has the lowest horizon
-    /// `J`, if one is below the SQP's and feasible within the band. (Not
-    /// inlined: its flights' state is not on the stack of the restart
-    /// that follows.)
+    /// `J`, if one is below the SQP's and feasible within the band (within
+    /// twice the band where it is carried through a plateau and no raise
+    /// clears track `g`). (Not inlined: its flights' state is not on the
+    /// stack of the restart that follows.)
     #[inline(never)]
     fn sink_start(
         &self,
