@@ -66,6 +66,11 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     pub gaps: &'a [Cell<f32>],
 }
 
+/// How far above its target (a share of the band `h_r − h_a`) a later
+/// track still counts as held where the depth loop integrates
+/// ([`PlanObjective::held_slack_teeth`]).
+pub(super) const TEETH_SLACK: f32 = 0.05;
+
 impl<'a, const N: usize> PlanObjective<'a, N> {
     /// The objective over `count` tracks from `track`, flown from `start`.
     pub fn new(
@@ -278,6 +283,20 @@ impl<const N: usize> PlanObjective<'_, N> {
     pub fn held_slack(&self, tol: f32) -> f32 {
         let m = self.sc.mission();
         tol.max(0.01 * (m.reference_altitude() - m.min_altitude()))
+    }
+
+    /// [`Self::held_slack`], but where the depth loop integrates at least
+    /// [`TEETH_SLACK`] of the band: the SQP stops where a tooth's gradient
+    /// says, short of the boundary (`lift/`, `polish.rs`), m.
+    pub(super) fn held_slack_teeth(&self, tol: f32) -> f32 {
+        let m = self.sc.mission();
+        let band = m.reference_altitude() - m.min_altitude();
+        let teeth = if self.teeth() {
+            TEETH_SLACK * band
+        } else {
+            0.0
+        };
+        self.held_slack(tol).max(teeth)
     }
 
     /// Tracks `j..j + used.len()` of the horizon flown at the depths

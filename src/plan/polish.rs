@@ -134,7 +134,8 @@
 //! deeper; the first depth's polish then took track 1 5 m deeper, which
 //! that shallow track 2 allowed, and the line was 1.113× the f64 search's
 //! best safe plan. So before the first depth, each later depth whose track
-//! clears its target by more than [`FREE`] of the band, and whose
+//! clears its target by more than 5 % of the band (the lift's
+//! [`TEETH_SLACK`](super::objective::TEETH_SLACK)), and whose
 //! gradient promises more than [`SHARE`] of `J` over [`STEP`], is
 //! polished the same way, the other depths held, against the same
 //! floors: 1.069× (track 2's descent stops at 1 335.2 m, where track 4's
@@ -191,10 +192,6 @@ const TOOTH: f32 = 0.01;
 
 /// Most doublings of the step.
 const DOUBLINGS: u32 = 8;
-
-/// The share of the band `h_r − h_a` by which a later track clears its
-/// target for its depth to count as free (module docs).
-const FREE: f32 = 0.05;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The polish of the module docs on the workspace's single track, in
@@ -287,7 +284,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// Whether later depth `i` of the SQP's end (its flight `end`) is
     /// stuck (module docs): its track clears its target by more than
-    /// [`FREE`] of the band `h_r − h_a` (and `tol`, m), and its gradient
+    /// [`PlanObjective::held_slack_teeth`] (m), and its gradient
     /// predicts more than [`SHARE`] of `J` over [`STEP`].
     fn stuck_later(
         &self,
@@ -296,8 +293,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         end: &[TrackScore; K],
         tol: f32,
     ) -> bool {
-        let m = obj.sc.mission();
-        let slack = tol.max(FREE * (m.reference_altitude() - m.min_altitude()));
+        let slack = obj.held_slack_teeth(tol);
         let w = &self.work;
         let (Some(s), Some(&g), Some(&lo), Some(&hi)) = (
             end.get(i),

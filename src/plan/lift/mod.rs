@@ -237,7 +237,7 @@
 //! plans and flights.
 //!
 //! A later track counts as held at its target within a hundredth of the
-//! band, but where the depth loop integrates within [`TEETH_SLACK`] of
+//! band, but where the depth loop integrates within [`TEETH_SLACK`](super::objective::TEETH_SLACK) of
 //! it: the SQP stops where a tooth's gradient says (`polish.rs`), short
 //! of the boundary. On `check_planner.py --seed 2003 --vehicle
 //! tools/reference/vehicles/integ.toml` (`unseen_2003_1`) track 2 ended
@@ -275,6 +275,7 @@ use crate::sim::{TrackScore, VehicleState};
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
 use super::scan::with_depth;
+use super::solve::horizon_flight;
 
 mod search;
 
@@ -284,11 +285,6 @@ use search::{Lift, Next, Starts};
 /// A freed start is tried where its horizon `J` is at most this share
 /// above the SQP's (module docs).
 pub(super) const FREED_SHARE: f32 = 0.25;
-
-/// How far above its target (a share of the band `h_r − h_a`) a later
-/// track still counts as held where the depth loop integrates (module
-/// docs).
-const TEETH_SLACK: f32 = 0.05;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// The escape of the module docs over a horizon of `h` tracks in
@@ -342,21 +338,23 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// (one plain flight): `bounds` with the depths before track `g` (the
     /// first) held at `z`'s, for a restart that cannot take the lift back
     /// (module docs).
+    #[inline(never)]
     fn lifts_held(
         &self,
         obj: &mut PlanObjective<'_, N>,
         z: &[f32; K],
         (g, bounds): (usize, &Bounds<K>),
     ) -> Option<Bounds<K>> {
-        if g != 1 || !obj.teeth() || horizon_j(obj, z)? >= self.work.j {
+        if g != 1 || !obj.teeth() {
             return None;
         }
+        // (One plain flight; a `J` that is not finite is not below.)
+        let (j, _, _) = horizon_flight(obj, z).ok()?;
+        (j < self.work.j).then_some(())?;
         let mut held = *bounds;
-        let pins = held.lo.iter_mut().zip(held.hi.iter_mut()).zip(z).take(g);
-        for ((lo, hi), &v) in pins {
-            let v = v.max(*lo).min(*hi);
-            (*lo, *hi) = (v, v);
-        }
+        let (lo, hi, &v) = (held.lo.first_mut()?, held.hi.first_mut()?, z.first()?);
+        let v = v.max(*lo).min(*hi);
+        (*lo, *hi) = (v, v);
         Some(held)
     }
 
@@ -378,8 +376,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<Starts<K>, Stop> {
         let h_r = obj.sc.mission().reference_altitude();
         let band = h_r - obj.sc.mission().min_altitude();
-        let teeth = if obj.teeth() { TEETH_SLACK * band } else { 0.0 };
-        let slack = obj.held_slack(tol).max(teeth);
+        let slack = obj.held_slack_teeth(tol);
         let j = g.saturating_sub(1);
         let z = self.work.z;
         let (head, at_j) = obj.head(&z, j)?;
@@ -482,17 +479,6 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let starts = [(a, band, loose), (b, band, loose), (None, band, loose)];
         Ok(ranked(obj, (&head, (&at_i, i)), starts, (band, loose))?.0)
     }
-}
-
-/// The horizon `J` of `z` by a plain flight, m³. Not inlined: the
-/// flight's scores stay off the restart's frame.
-#[inline(never)]
-fn horizon_j<const N: usize, const K: usize>(
-    obj: &mut PlanObjective<'_, N>,
-    z: &[f32; K],
-) -> Option<f32> {
-    let scores = obj.flight(z).ok()?;
-    obj.value_of(&scores).ok().map(|(j, _)| j)
 }
 
 /// The start whose horizon `J` (tracks before `j` from `head`, the rest
