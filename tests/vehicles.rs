@@ -1057,6 +1057,21 @@ fn a_sink_through_a_saturated_dive_raises_the_dive_too() {
     horizon_within("sink_carried", 1.05, 1.268_637e6);
 }
 
+/// A gap carried to the last track that no depth meets
+/// (`check_planner.py --seed 3015 --vehicle
+/// tools/reference/vehicles/fast.toml`, `unseen_3015_3`): track 5's
+/// least altitude is a floor set by its arrival, 22.03 m down to 1 074 m,
+/// and the call aimed 8.5 cm over the certified altitude by a gap two
+/// calls before had screened from a branch at waypoint 3. No depth met
+/// the aim, and the answer was the first safest scanned depth, 1 029.4 m:
+/// the line's `J` 6.733e6 m³, 1.157× the f64 beam search's best safe plan
+/// (5.817 528e6 m³). The aim is dropped where no depth meets it
+/// (`src/plan/gaps.rs`): 1.0046×.
+#[test]
+fn a_gap_no_depth_meets_is_dropped() {
+    horizon_within("aim_dropped", 1.02, 5.817_528e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of
