@@ -1065,8 +1065,8 @@ fn a_sink_through_a_saturated_dive_raises_the_dive_too() {
 /// calls before had screened from a branch at waypoint 3. No depth met
 /// the aim, and the answer was the first safest scanned depth, 1 029.4 m:
 /// the line's `J` 6.733e6 m³, 1.157× the f64 beam search's best safe plan
-/// (5.817 528e6 m³). The aim is dropped where no depth meets it
-/// (`src/plan/gaps.rs`): 1.0046×.
+/// (5.817 528e6 m³). The verification fallback drops the aim where no
+/// depth meets it (`src/plan/fallback.rs`, `closest_safe`): 1.0046×.
 #[test]
 fn a_gap_no_depth_meets_is_dropped() {
     horizon_within("aim_dropped", 1.02, 5.817_528e6);

@@ -11,7 +11,7 @@ use crate::optim::Bounds;
 use crate::sim::{Scenario, TrackScore, VehicleState};
 
 use super::certify::Certificate;
-use super::fallback::{Flown, fallback, from_warm};
+use super::fallback::{Flown, closest_safe};
 use super::flights::Flights;
 use super::objective::PlanObjective;
 use super::planner::Warm;
@@ -516,23 +516,23 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !self.cfg.constrained || score.min_altitude() >= s.h_safe {
             return Ok((flown, Found::Optimized(stop)));
         }
+        // (In horizon mode a single track's aim may be raised by a gap an
+        // earlier call kept, `candidate_aimed`; the fallback drops it
+        // where no depth meets it.)
         let warm = s.warm.and_then(|w| w.depths.first().copied());
-        if let (1, Some(z0)) = (s.h, warm) {
-            let alt = score.min_altitude();
-            let steps = self.cfg.bisection_steps;
-            if let Some(f) = from_warm(fl, z0, (z_opt, alt), s.h_safe, steps)? {
-                return Ok((f, Found::Boundary(stop)));
-            }
-        }
+        let warm = warm.filter(|_| s.h == 1);
+        let h_cert = match self.cfg.mode {
+            Mode::Horizon => self.cfg.certified_altitude(fl.sc.mission()),
+            Mode::TrackWise => s.h_safe,
+        };
         let lo = s.bounds.lo.first().copied().unwrap_or(z_opt);
         let hi = s.bounds.hi.first().copied().unwrap_or(z_opt);
-        let (f, safe) = fallback(
+        let (f, safe) = closest_safe(
             fl,
-            (z_opt, Some(score.min_altitude())),
+            (&flown, warm),
             (lo, hi),
-            s.h_safe,
-            self.cfg.scan_points,
-            self.cfg.bisection_steps,
+            (s.h_safe, h_cert),
+            (self.cfg.scan_points, self.cfg.bisection_steps),
             scan,
         )?;
         let found = if safe {

@@ -130,6 +130,52 @@ fn past_teeth<const N: usize>(
     best
 }
 
+/// The verification fallback of a single track whose optimum `opt` falls
+/// below the aimed altitude `h_aim` (m): the boundary from the warm start
+/// `warm` (m, [`from_warm`]) when it flies safe, else the closest safe
+/// depth ([`fallback`]). Returns the answer and whether it clears the aim.
+///
+/// Where the aim is the certified altitude `h_cert` (m) raised by a gap
+/// an earlier call's screening kept (`gaps.rs`, `candidate_aimed`) and no
+/// depth meets it, the aim is dropped: the optimum if it clears `h_cert`,
+/// else the same fallback towards `h_cert`, kept where it clears it.
+/// Where the track's least altitude is a floor set by its arrival, below
+/// the aim, the fallback answered the first safest scanned depth, not the
+/// least `J` on the floor (`check_planner.py --seed 3015 --vehicle
+/// tools/reference/vehicles/fast.toml`, `unseen_3015_3`, track 5: the
+/// floor 22.028 m down to 1 074 m, 2.6 cm over `h_cert`, the aim 8.5 cm
+/// over it from a branch at waypoint 3 two calls before; the answer was
+/// 1 029.4 m, `J` 1.20e6 against 3.1e5 m³ at 1 074 m). The scan is
+/// shared: the second fallback flies only its boundary search.
+pub(super) fn closest_safe<const N: usize>(
+    fl: &mut Flights<'_, '_, N>,
+    (opt, warm): (&Flown<N>, Option<f32>),
+    (lo, hi): (f32, f32),
+    (h_aim, h_cert): (f32, f32),
+    (scan_points, steps): (u32, u32),
+    log: &mut ScanLog,
+) -> Result<(Flown<N>, bool), PlanError> {
+    let toward = |fl: &mut Flights<'_, '_, N>, h_safe: f32, log: &mut ScanLog| {
+        let at = (opt.depth, opt.score.min_altitude());
+        if let Some(z0) = warm
+            && let Some(f) = from_warm(fl, z0, at, h_safe, steps)?
+        {
+            return Ok((f, true));
+        }
+        let bad = (at.0, Some(at.1));
+        fallback(fl, bad, (lo, hi), h_safe, scan_points, steps, log)
+    };
+    let aimed = toward(fl, h_aim, log)?;
+    if aimed.1 || h_cert >= h_aim {
+        return Ok(aimed);
+    }
+    if opt.score.min_altitude() >= h_cert {
+        return Ok((*opt, true));
+    }
+    let dropped = toward(fl, h_cert, log)?;
+    Ok(if dropped.1 { dropped } else { aimed })
+}
+
 /// A warm-started single track (the last of a horizon) whose optimum
 /// `(z_opt, alt_opt)` (m, m) fell below `h_safe`: the boundary between the
 /// warm start `z0` (the continuation's depth, which the previous call

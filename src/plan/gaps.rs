@@ -22,14 +22,12 @@
 //! over.
 
 use crate::optim::Bounds;
-use crate::sim::{Scenario, VehicleState};
+use crate::sim::Scenario;
 
-use super::candidate::Candidate;
 use super::certify::{MAX_TRACKS, Worlds};
 use super::commit::{certification_bottom, nominal_only};
 use super::objective::PlanObjective;
-use super::planner::Warm;
-use super::{Mode, PlanError, Planner};
+use super::{PlanError, Planner};
 
 /// Most rounds of raising the targets in one call.
 const GAP_ROUNDS: u32 = 3;
@@ -187,58 +185,5 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         self.horizon_len = h;
         Ok(iterations)
-    }
-
-    /// In horizon mode, a single track's candidate `c` (the line's last
-    /// track, or a horizon of one) that does not clear the certified
-    /// altitude raised by the track's gap: the gap an earlier call's
-    /// screening kept (`candidate_aimed`; a one-track horizon runs no
-    /// screening of its own) is an aim, and here no depth met it. Where
-    /// the track's least altitude is a floor set by its arrival, below
-    /// the aim, every depth failed it and the answer was the first
-    /// safest scanned depth, not the least `J` on the floor
-    /// (`check_planner.py --seed 3015 --vehicle
-    /// tools/reference/vehicles/fast.toml`, `unseen_3015_3`: track 5's
-    /// floor 22.028 m, 2.6 cm over the certified altitude, the aim
-    /// 8.5 cm over it from a branch at waypoint 3 two calls before; the
-    /// answer 1 029.4 m where 1 074.0 m is safe, `J` 1.20e6 against
-    /// 3.1e5 m³). The candidate is then made again aimed at the certified
-    /// altitude itself (the previous call's warm start `warm` restored,
-    /// the gap kept for a later call of the same track), and kept where
-    /// it clears it; `c` otherwise. Both candidates' flights counted.
-    /// Not inlined: its candidate stays off the first one's stack.
-    #[inline(never)]
-    pub(super) fn aim_dropped(
-        &mut self,
-        (sc, state, track): (&Scenario<'_, N>, &VehicleState<N>, usize),
-        c: Candidate<N>,
-        warm: Option<Warm<K>>,
-    ) -> Result<Candidate<N>, PlanError> {
-        let gap = self.gaps.get(track).copied().unwrap_or(0.0);
-        let h_safe = self.cfg.certified_altitude(sc.mission());
-        let wanted = self.cfg.mode == Mode::Horizon
-            && self.cfg.constrained
-            && gap > 0.0
-            && self.horizon_len == 1
-            && c.flown.score.min_altitude() < h_safe + gap;
-        if !wanted {
-            return Ok(c);
-        }
-        self.warm = warm;
-        if let Some(slot) = self.gaps.get_mut(track) {
-            *slot = 0.0;
-        }
-        let plain = self.candidate(sc, state, track);
-        if let Some(slot) = self.gaps.get_mut(track) {
-            *slot = gap;
-        }
-        let plain = plain?;
-        let mut kept = if plain.flown.score.min_altitude() >= h_safe {
-            plain
-        } else {
-            c
-        };
-        kept.evaluations = plain.evaluations.saturating_add(c.evaluations);
-        Ok(kept)
     }
 }

@@ -200,9 +200,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         self.plan_within(sc, state, track, self.cfg.max_evaluations)
     }
 
-    /// [`Planner::plan`] without a flight budget: the candidate (in a
-    /// single track of a horizon, aimed at the certified altitude where an
-    /// earlier call's gap could not be met, `gaps.rs`; track by
+    /// [`Planner::plan`] without a flight budget: the candidate (track by
     /// track after a knife edge, aimed again past the other switch's
     /// branch, `knife.rs`, every candidate's flights counted), then the
     /// commit. Not inlined: its candidate is not on the stack of a
@@ -216,9 +214,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> Result<Plan<N>, PlanError> {
         self.budget = Budget::NONE;
         self.tube.set_branch_cap(u32::MAX);
-        let warm = self.warm;
-        let first = self.candidate(sc, state, track)?;
-        let mut cand = self.aim_dropped((sc, state, track), first, warm)?;
+        let mut cand = self.candidate(sc, state, track)?;
         let mut spent = 0_u32;
         for _ in 0..BRANCH_ROUNDS {
             let Some(flights) = self.raised_past_the_branch(sc, state, track, &cand) else {
