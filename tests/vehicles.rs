@@ -333,6 +333,24 @@ fn a_boundary_on_a_sawtooth_gives_way_to_the_trend() {
     assert!(h >= 60.0, "track 1: least altitude {h}");
 }
 
+/// A boundary's check read on a tooth (`check_planner.py --seed 3018
+/// --vehicle tools/reference/vehicles/twoki.toml`, `unseen_3018_3`,
+/// constrained track by track). Track 4's scan put its optimum beyond
+/// the boundary (the best scanned `J` at 1 237.6 m, unsafe), but the
+/// optimum is interior (1 177.5 m, 9 m clear of `h_a`). The check that
+/// `J` does not fall from the boundary into the safe set took the root
+/// search's previous safe depth, 3 cm shallower, where a tooth of `J`
+/// rises: the track kept the boundary, 1 191.53 m, `J` 305 434 m³, 1.034×
+/// the f64 best 295 370 m³. Where the depth loop integrates, the check
+/// now looks 0.5 m or more away (`src/plan/single.rs`).
+#[test]
+fn a_boundary_check_looks_past_the_teeth() {
+    let premise = [(0, 1_104.71), (2, 1_105.522)];
+    let t = track_within("check_teeth", &["--mode", "track"], &premise, 3, 295_370.0);
+    let h = t["min_altitude"].as_f64().unwrap();
+    assert!(h >= 45.0, "track 4: least altitude {h}");
+}
+
 /// Teeth past a boundary (`check_planner.py --seed 2933 --vehicle
 /// tools/reference/vehicles/twoki.toml`, `unseen_2933_0`, constrained
 /// track by track). Track 2's least altitude has teeth 8 cm wide and 1 cm

@@ -16,6 +16,7 @@ use crate::optim::Outcome;
 use super::PlanError;
 use super::fallback::{Flown, boundary, fallback};
 use super::flights::Flights;
+use super::objective::teeth;
 use super::scan::ScanLog;
 use super::status::{Found, OptimizerStop};
 
@@ -76,7 +77,17 @@ pub(super) fn decide<const N: usize>(
             // one flight there.
             let inward = good.0 - z_b;
             let step = CHECK_STEP.min(libm::fabsf(inward)).copysign(inward);
-            let near = b.inner.filter(|p| libm::fabsf(p.0 - z_b) <= CHECK_STEP);
+            // (Where the depth loop integrates, `J` has teeth a few
+            // centimetres wide: a previous depth closer than the second
+            // look's step reads a tooth's slope, not the trend.)
+            let least = if teeth(&fl.sc) {
+                CHECK_SHORT * CHECK_STEP
+            } else {
+                0.0
+            };
+            let near = b
+                .inner
+                .filter(|p| (least..=CHECK_STEP).contains(&libm::fabsf(p.0 - z_b)));
             let (z_in, j_in) = match near {
                 Some(p) => p,
                 None => {
