@@ -1090,6 +1090,22 @@ fn a_gap_no_depth_meets_is_dropped() {
     horizon_within("aim_dropped", 1.02, 5.817_528e6);
 }
 
+/// A short track repaired by an earlier depth (`check_planner.py --seed
+/// 2994 --vehicle tools/reference/vehicles/integ.toml`, `unseen_2994_3`):
+/// the cold SQP ended 1.16 m short on track 5, whose least altitude
+/// track 2's depth sets (about a metre per metre, the f64 flights'
+/// secants), while its tangent row read track 1's and its own (the
+/// slopes between the integrator's switches). The repair raised track 5,
+/// which moves nothing, the call committed track 1 at 908.5 m with a
+/// continuation to the surface, and the line's `J` was 7.848e6 m³, 1.41×
+/// the f64 beam search's best safe plan (5.574 700e6 m³). The repair
+/// now raises the earlier depth the secants find (`src/plan/restart.rs`,
+/// `repaired_across`): 1.031×.
+#[test]
+fn a_short_track_is_repaired_by_an_earlier_depth() {
+    horizon_within("repair_across", 1.05, 5.574_700e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of

@@ -153,3 +153,62 @@ pub(super) fn repaired<const N: usize, const K: usize>(
     }
     None
 }
+
+/// The depth raised per look of [`repaired_across`], m: wider than the
+/// teeth (a few centimetres) of a least altitude where the depth loop
+/// integrates.
+const ACROSS_STEP: f32 = 0.5;
+
+/// The least rise of the short track's least altitude per metre an
+/// earlier depth is raised (m/m) for [`repaired_across`] to move it.
+const ACROSS_RATE: f32 = 0.5;
+
+/// Where the depth loop integrates and [`repaired`] fails: the last
+/// short track of `z` is held by an earlier depth, not its own. Its
+/// tangent rows miss that: they are the slopes between the integrator's
+/// switches, and the trend moves with the switches (`check_planner.py
+/// --seed 2994 --vehicle tools/reference/vehicles/integ.toml`,
+/// `unseen_2994_3`: the cold SQP ended 1.16 m short on track 5, whose
+/// row read `∂h_5/∂z = (−0.82, −0.006, 0, 0, −0.60)`, where the f64
+/// flights' secants over ±0.5 m read `(−0.02, −0.96, 0, 0, −0.04)`: track
+/// 2's depth sets it). Each depth up to that track raised by
+/// [`ACROSS_STEP`] (one plain flight each), the one whose raise lifts
+/// the track's least altitude most, at [`ACROSS_RATE`] or more, is
+/// raised by the shortfall and `tol` (m) over that rate, not above its
+/// box's `lo`; then [`repaired`] from there. Not inlined, as
+/// [`repaired`].
+#[inline(never)]
+pub(super) fn repaired_across<const N: usize, const K: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    z: &[f32; K],
+    bounds: &Bounds<K>,
+    tol: f32,
+) -> Option<[f32; K]> {
+    let scores = obj.flight(z).ok()?;
+    let count = obj.count.min(K);
+    let (t, short) = (0..count).rev().find_map(|t| {
+        let short = obj.target_of(t) - scores.get(t)?.min_altitude();
+        (short > 0.0).then_some((t, short))
+    })?;
+    let h = scores.get(t)?.min_altitude();
+    let mut best: Option<(usize, f32)> = None;
+    for j in 0..=t {
+        let mut up = *z;
+        let (slot, lo) = (up.get_mut(j)?, *bounds.lo.get(j)?);
+        if *slot - ACROSS_STEP < lo {
+            continue;
+        }
+        *slot -= ACROSS_STEP;
+        let s = obj.flight(&up).ok()?;
+        let rate = (s.get(t)?.min_altitude() - h) / ACROSS_STEP;
+        if best.is_none_or(|(_, r)| rate > r) {
+            best = Some((j, rate));
+        }
+    }
+    let (j, rate) = best.filter(|&(_, r)| r >= ACROSS_RATE)?;
+    let mut z = *z;
+    let lo = *bounds.lo.get(j)?;
+    let slot = z.get_mut(j)?;
+    *slot = crate::num::max(*slot - (short + tol) / rate, lo);
+    repaired(obj, &z, bounds, tol)
+}

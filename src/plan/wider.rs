@@ -97,7 +97,7 @@ use crate::optim::Bounds;
 use super::Planner;
 use super::flights::Flights;
 use super::objective::PlanObjective;
-use super::restart::repaired;
+use super::restart::{repaired, repaired_across};
 use super::scan::{BEAM_HELD, BEAM_WIDE, ScanLog, ScanSpec, scan_start};
 
 /// A track of a feasible SQP end whose least altitude is above this many
@@ -203,7 +203,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if v > band || iterations >= self.cfg.bfgs.max_iterations {
             return iterations;
         }
-        let Some(z) = repaired(obj, &end, bounds, tol) else {
+        // (Where the depth loop integrates, by an earlier depth too.)
+        let mut z = repaired(obj, &end, bounds, tol);
+        if z.is_none() && obj.teeth() {
+            z = repaired_across(obj, &end, bounds, tol);
+        }
+        let Some(z) = z else {
             return iterations;
         };
         let again = self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, true), iterations);
