@@ -9,6 +9,7 @@ use crate::optim::{BfgsConfig, Bounds};
 
 use super::Planner;
 use super::objective::PlanObjective;
+use super::scan::with_depth;
 
 impl<const K: usize, const N: usize> Planner<K, N> {
     /// Whether an escape that restarts from a feasible SQP end may run:
@@ -193,22 +194,17 @@ pub(super) fn repaired_across<const N: usize, const K: usize>(
     let h = scores.get(t)?.min_altitude();
     let mut best: Option<(usize, f32)> = None;
     for j in 0..=t {
-        let mut up = *z;
-        let (slot, lo) = (up.get_mut(j)?, *bounds.lo.get(j)?);
-        if *slot - ACROSS_STEP < lo {
+        let up = *z.get(j)? - ACROSS_STEP;
+        if up < *bounds.lo.get(j)? {
             continue;
         }
-        *slot -= ACROSS_STEP;
-        let s = obj.flight(&up).ok()?;
+        let s = obj.flight(&with_depth(z, j, up)).ok()?;
         let rate = (s.get(t)?.min_altitude() - h) / ACROSS_STEP;
         if best.is_none_or(|(_, r)| rate > r) {
             best = Some((j, rate));
         }
     }
     let (j, rate) = best.filter(|&(_, r)| r >= ACROSS_RATE)?;
-    let mut z = *z;
-    let lo = *bounds.lo.get(j)?;
-    let slot = z.get_mut(j)?;
-    *slot = crate::num::max(*slot - (short + tol) / rate, lo);
-    repaired(obj, &z, bounds, tol)
+    let raised = crate::num::max(*z.get(j)? - (short + tol) / rate, *bounds.lo.get(j)?);
+    repaired(obj, &with_depth(z, j, raised), bounds, tol)
 }
