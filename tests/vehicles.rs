@@ -1106,6 +1106,21 @@ fn a_short_track_is_repaired_by_an_earlier_depth() {
     horizon_within("repair_across", 1.05, 5.574_700e6);
 }
 
+/// A searched continuation no better than its anchor (`check_planner.py
+/// --seed 3030 --vehicle tools/reference/vehicles/integ.toml`,
+/// `unseen_3030_2`): at call 3 neither the candidate continuation nor its
+/// depth with the climb certified, so the search ran from the previous
+/// call's continuation (certified) towards the climb, the less unsafe end,
+/// and took the last certified point: tracks 4 and 5 at 90 and 85 m,
+/// near the surface. The line's `J` was 8.001e6 m³, 1.133× the f64 beam
+/// search's best safe plan (7.063 515e6 m³). The commit now keeps the
+/// anchor where its horizon `J` is lower and it certifies
+/// (`src/plan/search.rs`, `anchor_if_cheaper`): 1.0054×.
+#[test]
+fn a_cheaper_anchor_is_kept() {
+    horizon_within("anchor_cheaper", 1.02, 7.063_515e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of

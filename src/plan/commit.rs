@@ -11,7 +11,8 @@
 //! certified again whenever the vehicle flew the committed depth), else
 //! the shallowest depth on every track — towards the candidate, for the
 //! last certified point ([`crate::optim::root`] on the certified minimum
-//! altitude). With no anchor certified, the call is `infeasible` and
+//! altitude), and keeps the previous continuation instead where it
+//! certifies and its horizon `J` is lower. With no anchor certified, the call is `infeasible` and
 //! commits the safest continuation it tried. So whatever the horizon, the
 //! iteration cap or the budget, once a call has committed a certified
 //! continuation every later call has one: fewer iterations cost `J`, never
@@ -64,6 +65,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let at = (state, track);
         let (mut chosen, mut flown) =
             self.choose_flown(sc, bottom, at, (cand, how), &mut flights)?;
+        if guaranteed {
+            self.anchor_if_cheaper(
+                sc,
+                bottom,
+                at,
+                (cand, &mut chosen, &mut flown),
+                &mut flights,
+            )?;
+        }
         // The previous continuation on its waypoint's knife edge (`knife.rs`),
         // the candidate off it: the candidate's way instead.
         if chosen.previous && sc.on_edge(track, &flown.next) && !sc.on_edge(track, &cand.flown.next)
@@ -78,13 +88,30 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 chosen = c;
             }
         }
+        let how = (guaranteed, lazy);
+        Ok(self.settle((sc, bottom), at, cand, (&chosen, flown), how, flights))
+    }
+
+    /// After [`Planner::commit`] chose: keeps the continuation, moves the
+    /// worlds on past the committed depth (`flown`), builds the [`Plan`].
+    /// Not inlined: its frame stays off the choice's (the deepest) stack.
+    #[inline(never)]
+    fn settle(
+        &mut self,
+        (sc, bottom): (&Scenario<'_, N>, ProfileView<'_>),
+        (state, track): (&VehicleState<N>, usize),
+        cand: &Candidate<N>,
+        (chosen, flown): (&Chosen<N>, Flown<N>),
+        (guaranteed, lazy): (bool, bool),
+        mut flights: u32,
+    ) -> Plan<N> {
         let depth = chosen.depths[0];
         let minima = if chosen.previous {
             self.cont.minima
         } else {
             self.tube.minima_of(&chosen.cert)
         };
-        self.keep(&chosen, track, guaranteed);
+        self.keep(chosen, track, guaranteed);
         self.cont.minima = minima.filter(|_| guaranteed).map(|m| {
             // (The tracks after the committed one.)
             core::array::from_fn(|i| {
@@ -108,7 +135,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let safe = chosen.cert.all >= cand.h_safe;
         self.line_j += flown.score.j();
         self.cont.certified = (guaranteed && safe).then_some(chosen.cert);
-        let status = self.status(sc, cand, &chosen, safe);
+        let status = self.status(sc, cand, chosen, safe);
         // The declared worlds' least altitude: with nothing declared, the
         // nominal flight's (a branch world is no declared world: it only
         // makes the certificate, so `safe`, stricter: spec/cli.md).
@@ -117,7 +144,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         } else {
             chosen.cert.first
         };
-        Ok(self.answer(flown, cand, (status, safe, certified), flights))
+        self.answer(flown, cand, (status, safe, certified), flights)
     }
 
     /// [`Planner::choose`], with the chosen depth's nominal flight.
@@ -369,7 +396,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// The previous call's continuation for tracks `track..track + len`,
     /// if it covers them all (the climb to `shallow`, m, beyond them).
-    fn previous_continuation(
+    pub(super) fn previous_continuation(
         &self,
         track: usize,
         len: usize,

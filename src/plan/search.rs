@@ -6,13 +6,14 @@
 
 use crate::model::ProfileView;
 use crate::optim::root::{self, RootTol};
-use crate::sim::Scenario;
+use crate::sim::{Scenario, TrackScore, VehicleState};
 
-use super::Planner;
 use super::candidate::Candidate;
 use super::certify::Certificate;
 use super::chosen::Chosen;
+use super::fallback::{Flown, fly_committed};
 use super::planner::MAX_TRACKS;
+use super::{PlanError, Planner};
 
 /// The certified-altitude tolerance of the continuation search, m (as the
 /// single track's boundary search: 0.2 % of `h_r − h_a`, 1 mm to 2 cm).
@@ -142,6 +143,62 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         let ends = ((&found.depths, found.cert), (&target, cert_t));
         self.search(sc, bottom, ends, len, cand.h_safe, flights)
+    }
+
+    /// The previous call's continuation in place of a searched one
+    /// (`chosen`) whose horizon `J` (Σ of the horizon's tracks, one
+    /// nominal flight each) is above the continuation's, where that
+    /// continuation certifies (every world flown, the candidate's `h_safe`),
+    /// with its committed depth's nominal flight (`flown`). The search takes the last certified point
+    /// on its path, which can lie far from any good one: towards the
+    /// climb, the later tracks near the surface. Unbudgeted calls only (a
+    /// budgeted one keeps its flights for its fallback). Not inlined: its
+    /// frame stays off the search's stack.
+    #[inline(never)]
+    pub(super) fn anchor_if_cheaper(
+        &self,
+        sc: &Scenario<'_, N>,
+        bottom: ProfileView<'_>,
+        (state, track): (&VehicleState<N>, usize),
+        (cand, chosen, flown): (&Candidate<N>, &mut Chosen<N>, &mut Flown<N>),
+        flights: &mut u32,
+    ) -> Result<(), PlanError> {
+        let (len, h_safe) = (chosen.len, cand.h_safe);
+        let shallow = sc.mission().depth_limits()[0];
+        let a = match self.previous_continuation(track, len, shallow) {
+            Some(a) if chosen.searched && self.budget.limit == u32::MAX => a,
+            _ => return Ok(()),
+        };
+        let same = a.iter().zip(&chosen.depths).take(len);
+        if same.clone().all(|(x, y)| x.to_bits() == y.to_bits()) {
+            return Ok(());
+        }
+        let h = self.horizon_len.clamp(1, K).min(len);
+        let j = |d: &[f32; MAX_TRACKS], flights: &mut u32| {
+            let mut scores = [TrackScore::default(); K];
+            *flights = flights.saturating_add(1);
+            let d = d.get(..h).unwrap_or(&[]);
+            let scores = scores.get_mut(..h).unwrap_or(&mut []);
+            let ok = sc.fly(state, track, d, scores).is_ok();
+            ok.then(|| scores.iter().map(TrackScore::j).sum::<f32>())
+        };
+        let (Some(j_a), Some(j_c)) = (j(&a, flights), j(&chosen.depths, flights)) else {
+            return Ok(());
+        };
+        if j_a >= j_c {
+            return Ok(());
+        }
+        let d = a.get(..len).unwrap_or(&[]);
+        let cert = self.tube.certify(sc, bottom, d, (h_safe, flights));
+        if cert.all < h_safe || cert.partial {
+            return Ok(());
+        }
+        *chosen = Chosen {
+            searched: true,
+            ..Chosen::new(a, len, cert)
+        };
+        *flown = fly_committed(sc, (state, track), a[0], cand.flown, flights)?;
+        Ok(())
     }
 
     /// One round of [`Planner::search`]: the boundary of the critical
