@@ -1121,6 +1121,18 @@ fn a_cheaper_anchor_is_kept() {
     horizon_within("anchor_cheaper", 1.02, 7.063_515e6);
 }
 
+/// The SQP once more with secant constraint rows where the depth loop
+/// integrates (`make_lines.py`'s `unseen_5034_2`, the `integ` vehicle,
+/// seed 5034): the tangent rows are the slopes between the integrator's
+/// switches, and the cold call's escapes ended with the line's `J` at
+/// 9.546e6 m³, 1.047× the f64 beam search's best safe plan (9.121 193e6
+/// m³). Restarted from there with rows from plain flights 0.5 m apart
+/// (`src/plan/restart.rs`, `secant_restart`): 1.0002×.
+#[test]
+fn secant_rows_see_past_the_teeth() {
+    horizon_within("secant_rows", 1.02, 9.121_193e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of

@@ -64,7 +64,16 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     /// (`gaps.rs`). The caller's buffer, one cell per horizon track (none:
     /// no raise), written between the SQP's runs.
     pub gaps: &'a [Cell<f32>],
+    /// Whether the constraint rows are secants from plain flights
+    /// [`SECANT_STEP`] apart instead of tangents
+    /// ([`PlanObjective::secant_rows`]).
+    pub secant: bool,
 }
+
+/// The step of the constraint rows' secants, m: past the teeth of a
+/// least altitude where the depth loop integrates (a few centimetres
+/// wide), as the single track's second look (`single.rs`).
+pub(super) const SECANT_STEP: f32 = 0.5;
 
 /// How far above its target (a share of the band `h_r − h_a`) a later
 /// track still counts as held where the depth loop integrates
@@ -97,6 +106,7 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             target: (f32::NEG_INFINITY, f32::NEG_INFINITY),
             band: f32::INFINITY,
             gaps: &[],
+            secant: false,
         }
     }
 }
@@ -412,6 +422,9 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
             Err(err) => return Err(Stop::Sim(err)),
         };
         out.rows = rows;
+        if self.secant {
+            self.secant_rows(z, &e.scores, out)?;
+        }
         // Each segment's least altitude above its track's target.
         for (c, &t) in out.c.iter_mut().zip(out.group.iter()).take(rows) {
             *c -= self.target_of(usize::from(t));
@@ -429,6 +442,46 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
     fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Stop> {
         let scores = self.flight(z)?;
         self.value_of(&scores)
+    }
+}
+
+impl<const N: usize> PlanObjective<'_, N> {
+    /// Each constraint row of `out` made its track's secant: for every
+    /// depth `j` up to the row's track, the least altitude of a plain
+    /// flight with `z_j` [`SECANT_STEP`] deeper less `base`'s (the tangent
+    /// pass's scores at `z`), over the step (m/m). Where the depth loop
+    /// integrates, the least altitude has teeth and its tangent is the
+    /// slope between the integrator's switches, not the trend: on
+    /// `unseen_2994_3` (`BENCHMARKS.md`, round 34) track 5's row read
+    /// (−0.82, −0.006, 0, 0, −0.60) m/m where the f64 secants over
+    /// ±0.5 m read (−0.02, −0.96, 0, 0, −0.04). One plain flight a depth,
+    /// counted; not inlined: its frame stays off the tangent pass's
+    /// stack.
+    #[inline(never)]
+    fn secant_rows<const K: usize>(
+        &mut self,
+        z: &[f32; K],
+        base: &[TrackScore; K],
+        out: &mut Linearized<K>,
+    ) -> Result<(), Stop> {
+        for j in 0..self.count.min(K) {
+            let mut moved = *z;
+            if let Some(v) = moved.get_mut(j) {
+                *v += SECANT_STEP;
+            }
+            let scores = self.flight(&moved)?;
+            let rows = out.a.iter_mut().zip(out.group.iter()).take(out.rows);
+            for (row, &g) in rows {
+                let g = usize::from(g);
+                let (Some(hi), Some(lo)) = (scores.get(g), base.get(g)) else {
+                    continue;
+                };
+                if let Some(slot) = row.get_mut(j).filter(|_| g >= j) {
+                    *slot = (hi.min_altitude() - lo.min_altitude()) / SECANT_STEP;
+                }
+            }
+        }
+        Ok(())
     }
 }
 

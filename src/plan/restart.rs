@@ -118,6 +118,33 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         total
     }
+
+    /// Where the depth loop integrates: the SQP once more from the best
+    /// end so far, its constraint rows secants
+    /// ([`PlanObjective::secant_rows`]), kept if it ends better
+    /// ([`Planner::sqp_restart`]). The tangent rows steer the SQP along
+    /// the slopes between the integrator's switches; the secants see the
+    /// trend across them. On the 112 random lines of the four vehicles
+    /// whose depth loop integrates (`make_lines.py`), 31 lines end lower
+    /// (to 0.878×), 11 higher by 0.11 % at most, for 25 flights a line
+    /// (4 %); the other 192 lines and the 18 shared runs keep their plans.
+    /// Returns the iterations so far.
+    pub(super) fn secant_restart(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        iterations: u32,
+    ) -> u32 {
+        if !obj.teeth() {
+            return iterations;
+        }
+        let z = self.work.z;
+        obj.secant = true;
+        let kept = self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations);
+        obj.secant = false;
+        kept.unwrap_or(iterations)
+    }
 }
 
 /// Most flights of [`repaired`].

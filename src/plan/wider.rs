@@ -177,6 +177,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             None => iterations,
         };
         let iterations = self.stride_first(obj, (h, bounds), tol, iterations);
+        let iterations = self.secant_restart(obj, (h, bounds), tol, iterations);
         // The lift and the held edge once more where the escapes took `J`
         // well below where they ran (module docs of `lift/`).
         if self.work.j < AGAIN * lifted_at {
