@@ -1133,6 +1133,19 @@ fn secant_rows_see_past_the_teeth() {
     horizon_within("secant_rows", 1.02, 9.121_193e6);
 }
 
+/// The lift run again where the escapes took `J` 10 % below where it
+/// first ran (`make_lines.py`'s `unseen_5012_2`, the `integ` vehicle, seed
+/// 5012): the held edge took the horizon's `J` from 1.90e6 to 1.58e6 m³
+/// and left track 2 held by track 1, which the lift had seen 10 m above
+/// its target; the escapes ran the lift again only below 80 %, and the
+/// line's `J` was 1.552e6 m³, 1.2165× the f64 beam search's best safe
+/// plan (1.276 048e6 m³). At 90 % (`src/plan/wider.rs`, `AGAIN`) the
+/// lift runs again and lifts track 1 by 56 m: 1.0125×.
+#[test]
+fn the_lift_runs_again_after_the_held_edge() {
+    horizon_within("lift_held_again", 1.03, 1.276_048e6);
+}
+
 /// A held track's target walked along (`check_planner.py --seed 2749
 /// --vehicle tools/reference/vehicles/rate.toml`, `unseen_2749_4`): the
 /// cold SQP ended with track 3 at its target, held by track 2; a lift of
