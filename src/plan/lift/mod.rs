@@ -214,7 +214,8 @@
 //!
 //! The lift runs from the SQP's end, and the cold call's later escapes
 //! may move the plan far from there (`wider.rs`, `cold_escapes`): where
-//! they took the horizon's `J` below four fifths of where the lift ran,
+//! they took the horizon's `J` below nine tenths (round 35; four fifths
+//! before, `AGAIN`) of where the lift ran,
 //! the lift and the held edge run once more. On `check_planner.py --seed
 //! 2574 --vehicle tools/reference/vehicles/rate.toml` (`unseen_2574_1`)
 //! the lift ran at `J` 5.0e6 m³ (track 1 at 945 m), where no lift freed
