@@ -12,8 +12,8 @@
 //! the shallowest depth on every track — towards the candidate, for the
 //! last certified point ([`crate::optim::root`] on the certified minimum
 //! altitude), and keeps the previous continuation instead where it
-//! certifies and its horizon `J` is lower. With no anchor certified, the call is `infeasible` and
-//! commits the safest continuation it tried. So whatever the horizon, the
+//! certifies and its horizon `J` is lower. With no anchor certified, the
+//! call is `infeasible` and commits the safest continuation it tried. So whatever the horizon, the
 //! iteration cap or the budget, once a call has committed a certified
 //! continuation every later call has one: fewer iterations cost `J`, never
 //! safety.

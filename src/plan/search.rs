@@ -148,12 +148,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// The previous call's continuation in place of a searched one
     /// (`chosen`) whose horizon `J` (Σ of the horizon's tracks, one
     /// nominal flight each) is above the continuation's, where that
-    /// continuation certifies (every world flown, the candidate's `h_safe`),
-    /// with its committed depth's nominal flight (`flown`). The search takes the last certified point
-    /// on its path, which can lie far from any good one: towards the
-    /// climb, the later tracks near the surface. Unbudgeted calls only (a
-    /// budgeted one keeps its flights for its fallback). Not inlined: its
-    /// frame stays off the search's stack.
+    /// continuation certifies (every world flown, the candidate's
+    /// `h_safe`), with its committed depth's nominal flight (`flown`).
+    /// The search takes the last certified point on its path, which can
+    /// lie far from any good one: towards the climb, the later tracks near
+    /// the surface (`unseen_3030_2`, BENCHMARKS.md, round 35). Unbudgeted
+    /// calls only (a budgeted one keeps its flights for its fallback). Not
+    /// inlined: its frame stays off the search's stack.
     #[inline(never)]
     pub(super) fn anchor_if_cheaper(
         &self,
