@@ -221,14 +221,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // else one nominal flight.
         let prev_j = match cand.previous_j {
             Some(j) => j,
-            None => {
-                let h = self.horizon_len.max(1).min(len).min(K);
-                let mut scores = [TrackScore::default(); K];
-                *flights = flights.saturating_add(1);
-                let d = depths.get(..h)?;
-                sc.fly(state, track, d, scores.get_mut(..h)?).ok()?;
-                scores.iter().take(h).map(TrackScore::j).sum()
-            }
+            None => self.horizon_j(sc, (state, track), (&depths, len), flights)?,
         };
         let line = libm::fabsf(self.line_j) + libm::fabsf(prev_j);
         let better = self.work.j < prev_j - KEEP_SHARE * line;
@@ -246,6 +239,24 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             previous: true,
             ..Chosen::new(depths, len, cert)
         })
+    }
+
+    /// `Σ J` of the horizon's tracks (at most `len`, the continuation's)
+    /// of the continuation `depths` from `state` at `track`: one nominal
+    /// flight, counted; `None` where it fails.
+    pub(super) fn horizon_j(
+        &self,
+        sc: &Scenario<'_, N>,
+        (state, track): (&VehicleState<N>, usize),
+        (depths, len): (&[f32; MAX_TRACKS], usize),
+        flights: &mut u32,
+    ) -> Option<f32> {
+        let h = self.horizon_len.max(1).min(len).min(K);
+        let mut scores = [TrackScore::default(); K];
+        *flights = flights.saturating_add(1);
+        let d = depths.get(..h)?;
+        sc.fly(state, track, d, scores.get_mut(..h)?).ok()?;
+        Some(scores.iter().take(h).map(TrackScore::j).sum())
     }
 
     /// The continuation to commit (module docs): the candidate if it

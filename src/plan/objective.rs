@@ -9,6 +9,8 @@ use crate::optim::Objective;
 use crate::optim::sqp::{Constrained, Linearized};
 use crate::sim::{Scenario, SimError, TrackScore, VehicleState, Watch};
 
+use super::scan::with_depth;
+
 /// Why [`PlanObjective`] did not return a value: the flight failed, the
 /// budget is spent, or (a constrained single track) the optimizer has left
 /// the safe set and the boundary search takes over. An explicit stop, not an error
@@ -464,12 +466,8 @@ impl<const N: usize> PlanObjective<'_, N> {
         base: &[TrackScore; K],
         out: &mut Linearized<K>,
     ) -> Result<(), Stop> {
-        for j in 0..self.count.min(K) {
-            let mut moved = *z;
-            if let Some(v) = moved.get_mut(j) {
-                *v += SECANT_STEP;
-            }
-            let scores = self.flight(&moved)?;
+        for (j, &zj) in z.iter().enumerate().take(self.count) {
+            let scores = self.flight(&with_depth(z, j, zj + SECANT_STEP))?;
             let rows = out.a.iter_mut().zip(out.group.iter()).take(out.rows);
             for (row, &g) in rows {
                 let g = usize::from(g);

@@ -6,7 +6,7 @@
 
 use crate::model::ProfileView;
 use crate::optim::root::{self, RootTol};
-use crate::sim::{Scenario, TrackScore, VehicleState};
+use crate::sim::{Scenario, VehicleState};
 
 use super::candidate::Candidate;
 use super::certify::Certificate;
@@ -170,20 +170,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             Some(a) if chosen.searched && self.budget.limit == u32::MAX => a,
             _ => return Ok(()),
         };
-        let same = a.iter().zip(&chosen.depths).take(len);
-        if same.clone().all(|(x, y)| x.to_bits() == y.to_bits()) {
+        let mut same = a.iter().zip(&chosen.depths).take(len);
+        if same.all(|(x, y)| x.to_bits() == y.to_bits()) {
             return Ok(());
         }
-        let h = self.horizon_len.clamp(1, K).min(len);
-        let j = |d: &[f32; MAX_TRACKS], flights: &mut u32| {
-            let mut scores = [TrackScore::default(); K];
-            *flights = flights.saturating_add(1);
-            let d = d.get(..h).unwrap_or(&[]);
-            let scores = scores.get_mut(..h).unwrap_or(&mut []);
-            let ok = sc.fly(state, track, d, scores).is_ok();
-            ok.then(|| scores.iter().map(TrackScore::j).sum::<f32>())
-        };
-        let (Some(j_a), Some(j_c)) = (j(&a, flights), j(&chosen.depths, flights)) else {
+        let at = (state, track);
+        let j_a = self.horizon_j(sc, at, (&a, len), flights);
+        let j_c = self.horizon_j(sc, at, (&chosen.depths, len), flights);
+        let (Some(j_a), Some(j_c)) = (j_a, j_c) else {
             return Ok(());
         };
         if j_a >= j_c {
