@@ -1194,3 +1194,17 @@ fn a_unit_step_onto_a_flat_side_is_no_boundary() {
 fn a_wider_look_s_descent_is_looked_at_closer() {
     track_within("polish_back", &UNCONSTRAINED, &[], 0, 1.063_06e4);
 }
+
+/// The deepest useful depth sought within the band (`check_planner.py
+/// --seed 2772 --vehicle tools/reference/vehicles/second.toml`,
+/// `unseen_2772_1`): track 3, held at its target at 1 126.5 m, has its
+/// deepest useful depth 19.2 m deeper, under the band of 20 m, so the lift
+/// made no start there, and the line's `J` was 1.431e7 m³, 1.112× the f64
+/// beam search's best safe plan (1.287 089e7 m³), which lifts track 2 by
+/// 93 m for track 3 to fly 43 m deeper. Sought wherever it is deeper by
+/// more than the gain's slack (`src/plan/lift/search.rs`, `floor_start`):
+/// 1.0006×.
+#[test]
+fn the_deepest_depth_is_sought_within_the_band() {
+    horizon_within("floor_within_band", 1.02, 1.287_089e7);
+}

@@ -365,10 +365,12 @@ impl<const N: usize> Lift<N> {
     }
 
     /// Track `g` at its deepest useful depth (its deepest bottom less
-    /// `h_r`, m; not below `hi`, m), where that is more than the band
-    /// below the preferred one (module docs): a start restarted from after
-    /// the best one, since its `J` does not tell which ends better; with
-    /// track `g + 1` repaired ([`Lift::repaired`], `next_lo`).
+    /// `h_r`, m; not below `hi`, m), where that is more than the gain's
+    /// slack below the preferred one, or below track `g`'s own depth where
+    /// it is not held more than the band above the preferred one (module
+    /// docs): a start restarted from after the best one, since its `J`
+    /// does not tell which ends better; with track `g + 1` repaired
+    /// ([`Lift::repaired`], `next_lo`).
     pub(super) fn floor_start<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
@@ -378,7 +380,7 @@ impl<const N: usize> Lift<N> {
     ) -> Result<Option<[f32; K]>, Stop> {
         let floor = deepest(&obj.sc, obj.track.saturating_add(self.g), h_r)
             .map(|p| p.min(hi))
-            .filter(|&p| p > self.deep.unwrap_or(self.zg) + self.band);
+            .filter(|&p| p > self.deep.unwrap_or(self.zg) + self.slack);
         let lowest = match floor {
             Some(p) => Lift {
                 deep: Some(p),
