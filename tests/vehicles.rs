@@ -1208,3 +1208,17 @@ fn a_wider_look_s_descent_is_looked_at_closer() {
 fn the_deepest_depth_is_sought_within_the_band() {
     horizon_within("floor_within_band", 1.02, 1.287_089e7);
 }
+
+/// The walk along a held track's target by a quarter band
+/// (`check_planner.py --seed 3061 --vehicle
+/// tools/reference/vehicles/stiff.toml`, `unseen_3061_0`): track 3's
+/// clearing depth rises 11 m as track 2 is lifted 7 m, then jumps into a
+/// flight that puts tracks 4 and 5 into the bottom. The lift by the band
+/// (20 m) and its walk were past the jump, and the line's `J` was
+/// 1.578e6 m³, 1.126× the f64 beam search's best safe plan (1.401 469e6
+/// m³). Walked again by a quarter and a half band where the first step is
+/// past it (`src/plan/lift/search.rs`, `SHORT`): 1.0007×.
+#[test]
+fn the_walk_steps_short_of_a_jump() {
+    horizon_within("walk_short", 1.02, 1.401_469e6);
+}

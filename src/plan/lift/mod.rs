@@ -168,7 +168,7 @@
 //! walks along track `g`'s target: depth `g − 1` lifted by the band and
 //! depth `g` deepened by the secant's reach back to its target (one
 //! flight at as much again as was freed: `freed² / fell`, at most
-//! `REACH` = 4 times what was freed), at most `WALKS` = 2 steps, while
+//! `REACH` = 4 times what was freed), at most two steps (`WALKS`), while
 //! the start (one flight of the tail) stays feasible within the band and
 //! its horizon `J` falls below the SQP's. Its last step is restarted
 //! after the best start, where there is no far lift's. On
@@ -183,6 +183,20 @@
 //! (`unseen_5000_3` 0.943×, `unseen_5036_5` 0.981×) and 3 higher by at
 //! most 0.064 %, 6.1 flights a line more; the 18 shared runs keep their
 //! plans, Monterey 1's cold call at 1 flight more.
+//!
+//! Where the walk's first step leaves the tail more than the band from
+//! feasible, the band's lift went past a jump of track `g`'s least
+//! altitude (its low point moved), and the walk is made again with lifts
+//! of a quarter and a half band (`SHORT`). On `check_planner.py --seed
+//! 3061 --vehicle tools/reference/vehicles/stiff.toml` (`unseen_3061_0`)
+//! track 3's clearing depth rises from 377.3 m to 388.2 m as track 2 is
+//! lifted 7 m, with the line's `J` about 10 % lower, then jumps to 448 m,
+//! which puts tracks 4 and 5 into the bottom; the lift by the band (20 m) and
+//! its walk were past the jump, and the line was 1.126× the f64 search's
+//! best safe plan. The quarter band's start (5 m, its `J` 1 % below the
+//! SQP's) restarts to 1.0007×. On the 304 random lines one moves (by under
+//! 1e-5), 0.25 flights a line more; the 18 shared runs keep their plans
+//! and flights.
 //!
 //! A lift that reaches the box's floor (the surface) with track `g` at
 //! its deep depth within the band of its target is a start too, as a

@@ -17,8 +17,13 @@ const LIFTS: u32 = 8;
 /// The far lift, in bands: the doubling's reach (module docs).
 const FAR: f32 = 32.0;
 
-/// Steps of the walk along a held track's target (module docs).
-const WALKS: u32 = 2;
+/// The lifts of the walk along a held track's target, in bands (module
+/// docs).
+const WALKS: [f32; 2] = [1.0, 2.0];
+
+/// The walk's lifts, in bands, where its first step goes past a jump of
+/// the held track's least altitude (module docs).
+const SHORT: [f32; 2] = [0.25, 0.5];
 
 /// The most a walk's step deepens the held track, in what the lift freed
 /// of its least altitude.
@@ -282,28 +287,50 @@ impl<const N: usize> Lift<N> {
     }
 
     /// The walk along track `g`'s target of the module docs from `z`,
-    /// `first` track `g`'s least altitude (m) at the first lift: at most
-    /// [`WALKS`] steps, each depth `j` lifted by the band and depth `g`
-    /// deepened by the secant's reach to its target (one flight, at most
-    /// [`REACH`] times what was freed), flown whole from `head` (one
-    /// flight). The last step whose start is feasible within the band
-    /// with the horizon's `J` lower than the last's, from `sqp` (m³) on.
+    /// `first` track `g`'s least altitude (m) at the first lift: depth `j`
+    /// lifted to each of [`WALKS`] bands, or, where the first of those
+    /// leaves the tail more than the band from feasible (past a jump of
+    /// track `g`'s least altitude), of [`SHORT`] bands. The last step
+    /// whose start is feasible within the band with the horizon's `J`
+    /// lower than the last's, from `sqp` (m³) on.
     pub(super) fn walk<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         (z, first): ([f32; K], f32),
         (head, sqp): (&[TrackScore; K], f32),
     ) -> Result<Option<[f32; K]>, Stop> {
+        let (best, past) = self.steps(obj, (z, Some(first)), WALKS, (head, sqp))?;
+        if best.is_some() || !past {
+            return Ok(best);
+        }
+        Ok(self.steps(obj, (z, None), SHORT, (head, sqp))?.0)
+    }
+
+    /// The steps of [`Lift::walk`] to `lifts` (bands): each depth `j`
+    /// lifted there and depth `g` deepened by the secant's reach to its
+    /// target (one flight, at most [`REACH`] times what was freed; one
+    /// more for what was freed, but at the first lift where `first` has
+    /// it), flown whole from `head` (one flight). The best start, and
+    /// whether the first step's start was more than the band from
+    /// feasible.
+    fn steps<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        (z, first): ([f32; K], Option<f32>),
+        lifts: [f32; 2],
+        (head, sqp): (&[TrackScore; K], f32),
+    ) -> Result<(Option<[f32; K]>, bool), Stop> {
         let (j, g) = (self.j, self.g);
-        let (mut best, mut at, mut a) = (None, z, first);
-        for n in 0..WALKS {
-            let (Some(&zj), Some(&zg)) = (at.get(j), at.get(g)) else {
+        let (mut best, mut at) = (None::<([f32; K], f32)>, z);
+        for (n, lift) in lifts.into_iter().enumerate() {
+            let Some(&zg) = at.get(g) else {
                 break;
             };
-            let up = with_depth(&at, j, crate::num::max(zj - self.band, self.lo));
-            if n > 0 {
-                a = obj.least_at((&self.at_j, j), &up, g)?;
-            }
+            let up = with_depth(&at, j, crate::num::max(self.zj - lift * self.band, self.lo));
+            let a = match first.filter(|_| n == 0) {
+                Some(a) => a,
+                None => obj.least_at((&self.at_j, j), &up, g)?,
+            };
             // What the lift freed (m), and what deepening by as much takes.
             let freed = a - self.target;
             if freed.is_nan() || freed <= self.slack {
@@ -315,12 +342,15 @@ impl<const N: usize> Lift<N> {
             }
             let start = with_depth(&up, g, zg + (freed * freed / fell).min(REACH * freed));
             let (jz, v) = obj.tail_value(head, (&self.at_j, j), &start)?;
-            if v > self.band || jz.is_nan() || jz >= best.map_or(sqp, |(_, b)| b) {
+            if v > self.band {
+                return Ok((best.map(|(start, _)| start), n == 0));
+            }
+            if jz.is_nan() || jz >= best.map_or(sqp, |(_, b)| b) {
                 break;
             }
             (best, at) = (Some((start, jz)), start);
         }
-        Ok(best.map(|(start, _)| start))
+        Ok((best.map(|(start, _)| start), false))
     }
 
     /// The start at track `g`'s deep depth (`self.deep`) with the least
