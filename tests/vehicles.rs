@@ -1222,3 +1222,16 @@ fn the_deepest_depth_is_sought_within_the_band() {
 fn the_walk_steps_short_of_a_jump() {
     horizon_within("walk_short", 1.02, 1.401_469e6);
 }
+
+/// The deepest depth's start retreated where it leaves the next track in
+/// the bottom (`check_planner.py --seed 2724 --vehicle
+/// tools/reference/vehicles/low.toml`, `unseen_2724_2`): track 2's
+/// deepest useful depth left track 3 14 m below its minimum altitude, and
+/// with track 3 raised that start cost 2.8× the SQP's `J`; the line's `J`
+/// was 7.881e6 m³, 1.154× the f64 beam search's best safe plan (6.829
+/// 15e6 m³), which flies track 2 between the two. Retreated to where
+/// track 3 clears (`src/plan/lift/search.rs`, `retreated`): 0.986×.
+#[test]
+fn the_deepest_start_retreats_for_the_next_track() {
+    horizon_within("retreat_next", 1.0, 6.829_15e6);
+}

@@ -298,6 +298,26 @@
 //! search's best safe plan, where the line was 1.112×. On the 304 random
 //! lines of BENCHMARKS.md one line moves (by under 1e-5), 1.05 flights a
 //! line more; the 18 shared runs keep their plans and flights.
+//!
+//! The deepest depth's start that leaves track `g + 1` more than the band
+//! below its target has that track raised, as above; where that start's
+//! horizon `J` is not below the SQP's, depth `g` is retreated instead: the
+//! deepest depth `g` at least the band below the SQP's at which track `g +
+//! 1`, at its own depth, clears its target (one flight to see that it
+//! does there, then [`NARROW`](super::raise::NARROW) bisections), with the
+//! least lift of depth `g − 1` that frees track `g` at that depth
+//! (`NARROW` more). On `check_planner.py --seed 2724 --vehicle
+//! tools/reference/vehicles/low.toml` (`unseen_2724_2`) track 2's deepest
+//! useful depth, 130 m below the SQP's, left track 3 14 m below its
+//! minimum altitude, and with track 3 raised the start's `J` was 2.8×
+//! the SQP's; the best plan flies track 2 at 1 056 m, between, so that
+//! the deep track 3 is reached from a deeper arrival. The line was
+//! 1.154× the f64 search's best safe plan; retreated (track 2 at 1 069.6
+//! m, track 1 lifted 147 m, `J` 0.91× the SQP's), its restart ends at
+//! 0.986×. On the 304 random lines 5 move, 3 lower
+//! (`unseen_5026_0`, `second`, from 1.115× the f64 best to 0.961×), none
+//! higher by 1e-5, 3.8 flights a line more; the 18 shared runs keep their
+//! plans, Monterey 1's cold call at 1 flight more.
 
 use crate::optim::Bounds;
 use crate::sim::{TrackScore, VehicleState};
@@ -443,10 +463,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let (saturated, [freed, deeper, far, deep]) = l.starts(obj, z, found)?;
         // The deepest depth's start, and the freed start's deepest depth
         // `g`, with the track after `g` raised where it leaves it more than
-        // the band below its target (module docs).
+        // the band below its target (module docs); the first also as it is
+        // where it does (`short`).
         let next_lo = bounds.lo.get(g.saturating_add(1)).copied();
         let deeper = l.repaired(obj, deeper, next_lo)?;
-        let lowest = l.floor_start(obj, z, (h_r, hi), next_lo)?;
+        let [short, raised] = l.floor_start(obj, z, (h_r, hi), next_lo)?;
         // The start whose horizon `J` is lowest: a freed one (feasible
         // within the band) up to a share above the SQP's, a deep one below.
         let (sqp, loose) = (self.work.j, (1.0 + FREED_SHARE) * self.work.j);
@@ -457,11 +478,18 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         ];
         let (best, deep_j) = ranked(obj, (&head, (&at_j, j)), starts, (band, loose))?;
         let walked = l.walk(obj, (z, first), (&head, sqp))?;
-        let mut below = |start: Option<[f32; K]>| match start {
+        let below = |obj: &mut PlanObjective<'_, N>, start: Option<[f32; K]>| match start {
             Some(start) if obj.tail_value(&head, (&at_j, j), &start)?.0 < sqp => Ok(Some(start)),
             _ => Ok(None),
         };
-        let (far, lowest) = (below(far)?.or(walked), below(lowest)?);
+        let far = below(obj, far)?.or(walked);
+        // The deepest depth's start with the next track raised, else with
+        // depth `g` retreated (module docs).
+        let mut lowest = below(obj, raised)?;
+        if lowest.is_none() {
+            let retreated = l.retreated(obj, short)?;
+            lowest = below(obj, retreated)?;
+        }
         let before = match saturated {
             Some(lift) if j > 0 && deep_j < sqp => self.lift_before(obj, bounds, &l, (z, lift))?,
             _ => None,

@@ -407,7 +407,7 @@ impl<const N: usize> Lift<N> {
         z: [f32; K],
         (h_r, hi): (f32, f32),
         next_lo: Option<f32>,
-    ) -> Result<Option<[f32; K]>, Stop> {
+    ) -> Result<[Option<[f32; K]>; 2], Stop> {
         let floor = deepest(&obj.sc, obj.track.saturating_add(self.g), h_r)
             .map(|p| p.min(hi))
             .filter(|&p| p > self.deep.unwrap_or(self.zg) + self.slack);
@@ -419,33 +419,97 @@ impl<const N: usize> Lift<N> {
             .deep_start(obj, z)?,
             None => None,
         };
-        self.repaired(obj, lowest, next_lo)
+        let Some(lo) = next_lo else {
+            return Ok([None, lowest]);
+        };
+        Ok(match self.short_next(obj, lowest)? {
+            Some(short) => [Some(short), Some(self.raise_next(obj, short, lo)?)],
+            None => [None, lowest],
+        })
     }
 
     /// `start` (if any) with track `g + 1`'s depth raised, where the start
-    /// leaves that track more than the band below its target, to the
-    /// deepest depth found that clears it ([`raised`]); one flight of
-    /// tracks `j..=g + 1` each, and one to see whether it is needed.
+    /// leaves that track more than the band below its target
+    /// ([`Lift::short_next`]), to the deepest depth found that clears it
+    /// ([`Lift::raise_next`]).
     pub(super) fn repaired<const K: usize>(
         &self,
         obj: &mut PlanObjective<'_, N>,
         start: Option<[f32; K]>,
         lo: Option<f32>,
     ) -> Result<Option<[f32; K]>, Stop> {
-        let k = self.g.saturating_add(1);
-        let (Some(z), Some(lo)) = (start, lo) else {
+        let Some(lo) = lo else {
             return Ok(start);
         };
-        if k >= obj.count || z.get(k).is_none() {
-            return Ok(start);
+        match self.short_next(obj, start)? {
+            Some(z) => Ok(Some(self.raise_next(obj, z, lo)?)),
+            None => Ok(start),
         }
+    }
+
+    /// `start`, where it leaves track `g + 1` more than the band below its
+    /// target (one flight of tracks `j..=g + 1`).
+    fn short_next<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        start: Option<[f32; K]>,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let k = self.g.saturating_add(1);
+        let Some(z) = start.filter(|z| k < obj.count && z.get(k).is_some()) else {
+            return Ok(None);
+        };
+        let target = obj.target_of(k);
+        let low = obj.least_at((&self.at_j, self.j), &z, k)? < target - self.band;
+        Ok(low.then_some(z))
+    }
+
+    /// `z` with track `g + 1`'s depth raised to the deepest found that
+    /// clears its target ([`raised`], not above `lo`, m; one flight of
+    /// tracks `j..=g + 1` each), or as it is where none does.
+    fn raise_next<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        z: [f32; K],
+        lo: f32,
+    ) -> Result<[f32; K], Stop> {
+        let k = self.g.saturating_add(1);
         let target = obj.target_of(k);
         let from = (&self.at_j, self.j);
-        if obj.least_at(from, &z, k)? >= target - self.band {
-            return Ok(start);
-        }
         let d = raised(obj, from, (&z, (k, k)), (target, self.band, lo))?;
-        Ok(Some(d.map_or(z, |d| with_depth(&z, k, d))))
+        Ok(d.map_or(z, |d| with_depth(&z, k, d)))
+    }
+
+    /// The deepest depth's start `short` (one that leaves track `g + 1`
+    /// more than the band below its target) with depth `g` retreated
+    /// instead (module docs): the deepest depth `g` toward the SQP's, at
+    /// least the band below it, at which track `g + 1` clears its target
+    /// ([`NARROW`](super::raise::NARROW) bisections), with the least lift
+    /// of depth `j` that frees track `g` there ([`Lift::narrowed`]). None
+    /// where track `g + 1` does not clear it the band below the SQP's
+    /// depth (one flight of tracks `j..=g + 1`).
+    pub(super) fn retreated<const K: usize>(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        short: Option<[f32; K]>,
+    ) -> Result<Option<[f32; K]>, Stop> {
+        let (g, k) = (self.g, self.g.saturating_add(1));
+        let Some(z) = short else {
+            return Ok(None);
+        };
+        let (Some(&zj), Some(&zg)) = (z.get(self.j), z.get(g)) else {
+            return Ok(None);
+        };
+        let (target, from) = (obj.target_of(k), (&self.at_j, self.j));
+        let clear = self.zg + self.band;
+        if zg <= clear || obj.least_at(from, &with_depth(&z, g, clear), k)? < target {
+            return Ok(None);
+        }
+        let d = clearing(obj, from, (k, target), (&z, (g, |d| d)), (clear, zg))?;
+        let at = Lift {
+            deep: Some(d),
+            ..*self
+        };
+        Ok(Some(at.narrowed(obj, z, (0.0, self.zj - zj))?))
     }
 
     /// The start at track `g`'s preferred depth with the least lift in
