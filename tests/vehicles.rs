@@ -1235,3 +1235,27 @@ fn the_walk_steps_short_of_a_jump() {
 fn the_deepest_start_retreats_for_the_next_track() {
     horizon_within("retreat_next", 1.0, 6.829_15e6);
 }
+
+/// A dive begun a track earlier (`check_planner.py --seed 2848 --vehicle
+/// tools/reference/vehicles/slow.toml`, `unseen_2848_5`): track 4's bottom
+/// falls 43° away and the slow vehicle, diving at its pitch limit the
+/// whole track, flew 72.7 m above it at its least, 5.38e6 of the line's
+/// 6.19e6 m³; its depth had no gradient, and track 3 before it was held
+/// at its target. The line's `J` was 1.425× the f64 beam search's best
+/// safe plan (4.339 417e6 m³), which climbs 333 m on track 2 and sets
+/// track 3 290 m deeper. Restarted with track 3 at track 4's depth
+/// (`src/plan/dive.rs`): 0.928×.
+#[test]
+fn a_saturated_dive_begins_a_track_earlier() {
+    horizon_within("dive_earlier", 1.0, 4.339_417e6);
+}
+
+/// The same on the default vehicle (`make_lines.py`'s `unseen_5011_5`,
+/// seed 5011): tracks 4 and 5 flew 165 and 143 m above their bottom at
+/// their least, and the line's `J` was 1.042e7 m³, 2.010× the f64 beam
+/// search's best safe plan (5.182 672e6 m³), which climbs 99 m on track 2
+/// for track 3 to dive 105 m deeper: 1.0010×.
+#[test]
+fn a_saturated_dive_begins_earlier_on_the_default_vehicle() {
+    horizon_within("dive_earlier_default", 1.02, 5.182_672e6);
+}

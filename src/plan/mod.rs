@@ -144,6 +144,7 @@ mod certify;
 mod chosen;
 mod commit;
 mod config;
+mod dive;
 mod edge;
 mod fallback;
 mod flights;

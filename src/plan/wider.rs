@@ -178,6 +178,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         iterations = self.lift_then_held(obj, (h, bounds), tol, iterations);
         iterations = self.sink_earlier(obj, (h, bounds), tol, iterations);
         iterations = self.probe_deeper(obj, (h, bounds), tol, iterations);
+        iterations = self.dive_earlier(obj, (h, bounds), tol, iterations);
         let at = (tol, h_safe, iterations);
         let iterations = match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
             Some(it) => self.lift_then_held(obj, (h, bounds), tol, it),

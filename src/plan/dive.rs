@@ -1,0 +1,134 @@
+//! A later track whose dive is saturated the whole track, flying high
+//! above its target, after a track held at its target: its depth does
+//! not move `J` (the vehicle dives at the pitch limit and never reaches
+//! it), and the held track before it would have the dive begin earlier,
+//! but its own target holds it. The best plan can set the held track's
+//! reference far deeper, below its own bottom, so that the dive is under
+//! way before the later track begins, and climb on the track before so
+//! that the early dive passes the held track's bottom. No single depth's
+//! move sees that: the held track's row says it cannot go deeper, and
+//! the later one's depth has no gradient.
+//!
+//! On `check_planner.py --seed 2848 --vehicle
+//! tools/reference/vehicles/slow.toml` (`unseen_2848_5`) the cold SQP
+//! ended with track 3 0.79 m above its target at 690.0 m, `∂J/∂z_3`
+//! −9.2e4 m², and track 4 at 1 115.5 m, 72.7 m above the bottom at its
+//! least (its target 60 m), `∂J/∂z_4` zero, 5.38e6 of the line's 6.19e6
+//! m³: its bottom falls 43° away and the slow vehicle dives too late.
+//! The f64 search's best safe plan climbs 333 m on track 2 and sets track
+//! 3 at 980 m. The line was 1.425× that plan's `J`.
+//!
+//! The escape: for each later track `t` (from the third) whose depth's
+//! gradient is within [`FLAT`] of the horizon's `J` over the band `h_r −
+//! h_a`, more than the band deeper than track `t − 1`, where `∂J/∂z_{t −
+//! 1}` is negative (these from the SQP's end, no flight), and, from one
+//! flight of the horizon, track `t` [`NEAR`] of the band above its target
+//! or more and track `t − 1` within that of its target: the SQP restarted
+//! with depth `t − 1` set to depth `t` (kept if it ends better). That
+//! start is far from feasible (track 3 89 m into the bottom); the
+//! restart's restoration climbs on the tracks before. `unseen_2848_5`
+//! ends at 0.928× the f64 search's best safe plan (track 2 at 489 m,
+//! track 3 at 1 115.5 m). On `make_lines.py`'s `unseen_5011_5` (the default
+//! vehicle) the line was 2.010× the f64 best safe plan and is 1.0010×. On
+//! the 304 random lines of BENCHMARKS.md 6 move, 5 lower (also
+//! `unseen_5021_1` 0.942×, `unseen_5001_2` 0.997×) and one higher by
+//! under 1e-5 (a line with no safe plan), 4.1 flights a line more; the 18
+//! shared runs keep their plans, Monterey 2's cold call at 1 flight more
+//! (Monterey 1's later tracks climb: no flight). Before the test on the
+//! depths without a flight (a later track deeper, the held one's gradient
+//! negative), Monterey 1's cold call flew once more for nothing.
+
+use crate::optim::constrained::group_bit;
+use crate::optim::{Bounds, Outcome};
+
+use super::Planner;
+use super::objective::{PlanObjective, Stop};
+use super::scan::with_depth;
+
+/// A later depth's gradient counts as flat within this share of the
+/// horizon's `J` over the band `h_r − h_a`.
+const FLAT: f32 = 1e-4;
+
+/// The share of the band by which the later track flies above its target,
+/// and within which the track before is at its own.
+const NEAR: f32 = 0.1;
+
+impl<const K: usize, const N: usize> Planner<K, N> {
+    /// The escape of the module docs over a horizon of `h` tracks in
+    /// `bounds`, feasible within `tol` (m), after `iterations`. Returns the
+    /// iterations so far.
+    pub(super) fn dive_earlier(
+        &mut self,
+        obj: &mut PlanObjective<'_, N>,
+        (h, bounds): (usize, &Bounds<K>),
+        tol: f32,
+        mut iterations: u32,
+    ) -> u32 {
+        let m = obj.sc.mission();
+        let band = m.reference_altitude() - m.min_altitude();
+        if !(2..h).any(|t| diving(&self.work, t, band))
+            || !self.feasible_with_room(obj, tol, iterations)
+        {
+            return iterations;
+        }
+        let z = self.work.z;
+        let Ok(tracks) = self.dive_tracks(obj, h, (band, tol)) else {
+            return iterations;
+        };
+        for t in (2..h).filter(|&t| group_bit(t).is_some_and(|b| tracks & b != 0)) {
+            let (Some(&zt), Some(&hi)) = (z.get(t), bounds.hi.get(t.saturating_sub(1))) else {
+                continue;
+            };
+            let start = with_depth(&z, t.saturating_sub(1), crate::num::min(zt, hi));
+            if let Some(total) =
+                self.sqp_restart(obj, &start, (h, bounds), (tol, 0.0, false), iterations)
+            {
+                iterations = total;
+            }
+        }
+        iterations
+    }
+
+    /// The later tracks `t` of the module docs (bit `t` set), from one
+    /// flight of the workspace. (Not inlined: the flight's scores stay
+    /// off the restarts' stack.)
+    #[inline(never)]
+    fn dive_tracks(
+        &self,
+        obj: &mut PlanObjective<'_, N>,
+        h: usize,
+        (band, tol): (f32, f32),
+    ) -> Result<u32, Stop> {
+        let scores = obj.flight(&self.work.z)?;
+        let near = NEAR * band + obj.held_slack_teeth(tol);
+        let mut tracks = 0;
+        for t in 2..h {
+            let g = t.saturating_sub(1);
+            let (Some(st), Some(sg)) = (scores.get(t), scores.get(g)) else {
+                continue;
+            };
+            let high = st.min_altitude() >= obj.target_of(t) + NEAR * band;
+            let held = sg.min_altitude() <= obj.target_of(g) + near;
+            if diving(&self.work, t, band) && high && held {
+                tracks |= group_bit(t).unwrap_or(0);
+            }
+        }
+        Ok(tracks)
+    }
+}
+
+/// Whether later track `t` of the SQP's end `w` dives from the track
+/// before (module docs): its depth's gradient flat, its depth more than
+/// the `band` (m) below the one before, whose gradient is negative.
+fn diving<const K: usize>(w: &Outcome<K>, t: usize, band: f32) -> bool {
+    let g = t.saturating_sub(1);
+    let flat = w
+        .gradient
+        .get(t)
+        .is_some_and(|d| d.abs() * band <= FLAT * w.j);
+    let deeper =
+        w.z.get(t)
+            .zip(w.z.get(g))
+            .is_some_and(|(zt, zg)| *zt > *zg + band);
+    flat && deeper && w.gradient.get(g).is_some_and(|d| *d < 0.0)
+}
