@@ -66,51 +66,53 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     ) -> u32 {
         let m = obj.sc.mission();
         let band = m.reference_altitude() - m.min_altitude();
-        if !(2..h).any(|t| diving(&self.work, t, band))
-            || !self.feasible_with_room(obj, tol, iterations)
-        {
+        // The later tracks that dive, from the SQP's end (no flight).
+        let dives = (2..h)
+            .filter(|&t| diving(&self.work, t, band))
+            .fold(0, |set, t| set | group_bit(t).unwrap_or(0));
+        if dives == 0 || !self.feasible_with_room(obj, tol, iterations) {
             return iterations;
         }
         let z = self.work.z;
-        let Ok(tracks) = self.dive_tracks(obj, h, (band, tol)) else {
+        let Ok(tracks) = self.dive_tracks(obj, (dives, h), (band, tol)) else {
             return iterations;
         };
         for t in (2..h).filter(|&t| group_bit(t).is_some_and(|b| tracks & b != 0)) {
-            let (Some(&zt), Some(&hi)) = (z.get(t), bounds.hi.get(t.saturating_sub(1))) else {
+            let g = t.saturating_sub(1);
+            let (Some(&zt), Some(&hi)) = (z.get(t), bounds.hi.get(g)) else {
                 continue;
             };
-            let start = with_depth(&z, t.saturating_sub(1), crate::num::min(zt, hi));
-            if let Some(total) =
-                self.sqp_restart(obj, &start, (h, bounds), (tol, 0.0, false), iterations)
-            {
-                iterations = total;
-            }
+            let start = with_depth(&z, g, crate::num::min(zt, hi));
+            iterations = self
+                .sqp_restart(obj, &start, (h, bounds), (tol, 0.0, false), iterations)
+                .unwrap_or(iterations);
         }
         iterations
     }
 
-    /// The later tracks `t` of the module docs (bit `t` set), from one
-    /// flight of the workspace. (Not inlined: the flight's scores stay
-    /// off the restarts' stack.)
+    /// The tracks of `dives` (bit `t` set for later track `t`, of the `h`)
+    /// that fly high after a held track (module docs), from one flight of
+    /// the workspace. (Not inlined: the flight's scores stay off the
+    /// restarts' stack.)
     #[inline(never)]
     fn dive_tracks(
         &self,
         obj: &mut PlanObjective<'_, N>,
-        h: usize,
+        (dives, h): (u32, usize),
         (band, tol): (f32, f32),
     ) -> Result<u32, Stop> {
         let scores = obj.flight(&self.work.z)?;
         let near = NEAR * band + obj.held_slack_teeth(tol);
         let mut tracks = 0;
         for t in 2..h {
-            let g = t.saturating_sub(1);
+            let (g, bit) = (t.saturating_sub(1), group_bit(t).unwrap_or(0));
             let (Some(st), Some(sg)) = (scores.get(t), scores.get(g)) else {
                 continue;
             };
             let high = st.min_altitude() >= obj.target_of(t) + NEAR * band;
             let held = sg.min_altitude() <= obj.target_of(g) + near;
-            if diving(&self.work, t, band) && high && held {
-                tracks |= group_bit(t).unwrap_or(0);
+            if dives & bit != 0 && high && held {
+                tracks |= bit;
             }
         }
         Ok(tracks)

@@ -73,11 +73,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 Ok(None) => continue,
                 Err(_) => break,
             };
-            if let Some(total) =
-                self.sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
-            {
-                iterations = total;
-            }
+            iterations = self
+                .sqp_restart(obj, &z, (h, bounds), (tol, 0.0, false), iterations)
+                .unwrap_or(iterations);
         }
         iterations
     }
