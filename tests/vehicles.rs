@@ -1259,3 +1259,16 @@ fn a_saturated_dive_begins_a_track_earlier() {
 fn a_saturated_dive_begins_earlier_on_the_default_vehicle() {
     horizon_within("dive_earlier_default", 1.02, 5.182_672e6);
 }
+
+/// A plateau whose scan stepped over a feasible window to a cliff
+/// (`make_lines.py`'s `unseen_5007_6`, seed 5007, the `fast` vehicle):
+/// track 2's climb is saturated for depths shallower than about 410 m,
+/// where the SQP stopped (342.7 m, no gradient); the plateau scan read
+/// 402 m flat and 538 m 141 m short with a higher `J`, and the line's `J`
+/// was 1.109× the f64 beam search's best safe plan (2.003 423e6 m³), which
+/// flies track 2 at 445 m. The step off the plateau bisected
+/// (`src/plan/jump.rs`, `bisect_steps`): 0.986×.
+#[test]
+fn a_plateau_step_to_a_cliff_is_bisected() {
+    horizon_within("plateau_cliff", 1.0, 2.003_423e6);
+}

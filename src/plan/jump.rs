@@ -14,6 +14,20 @@
 //! lower, the pair is bisected [`EDGE`] times (one flight of the tail
 //! each) for the feasible point nearest the cliff.
 //!
+//! The window can lie between the plateau and a scanned point beyond the
+//! band whose `J` is higher: on `make_lines.py`'s `unseen_5007_6` (seed
+//! 5007, `fast`) track 2's climb is saturated for `z_2` shallower than
+//! about 410 m, where the SQP stopped (342.7 m); the scan read 402 m flat
+//! and 538 m 141 m short at a higher `J`, past a window near 445 m where
+//! both `J` and track 3's are lower and every track clears. The line's
+//! `J` was 1.109× the f64 best safe plan's. Where the scan keeps no
+//! point, and no step leaves the plateau within the band, its first step
+//! off the plateau to beyond the band is bisected [`EDGE`] times for the
+//! first point off it within the band (`bisect_steps`): 0.986×. Not in
+//! the held edges' pass, after the plateau rounds. On the 304 random
+//! lines 5 move (`unseen_5034_0` 0.990×; one higher, by 2e-5), +0.5
+//! flights a line; the 18 shared runs keep their plans and flights.
+//!
 //! From an infeasible optimum, the scan weighs the points less infeasible
 //! than it by `J` plus their shortfall priced at [`RESTORE_SHARE`] of the
 //! merit weight, as it weighs a feasible optimum's. It took the point of
@@ -57,7 +71,7 @@ use super::scan::{grid, reach_from, with_depth};
 use super::solve::{RESTORE_SHARE, lex_less};
 
 /// Bisections of a scan's step from a point within the band to one
-/// beyond it with a lower `J`.
+/// beyond it with a lower `J`, or off the plateau to beyond the band.
 const EDGE: u32 = 3;
 
 /// Steps further off a plateau's edge (the band `h_r − h_a`, doubling)
@@ -73,6 +87,9 @@ const PRICED_OUT: f32 = 1e30;
 
 /// A scanned point: `(z_j, Σ J, v)`, m, m³, m.
 type Point = (f32, f32, f32);
+
+/// A step between two scanned points.
+type Step = (Point, Point);
 
 /// A restart candidate: its score (shortfall, `J`) and its depths.
 type Jump<const K: usize> = ((f32, f32), [f32; K]);
@@ -131,12 +148,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         };
         let mut best: Option<Jump<K>> = None;
-        let mut keep = |p: Point, z: [f32; K]| {
-            if let Some((s, bar)) = score(p)
-                && lex_less(s, best.as_ref().map_or(bar, |b| b.0))
-            {
-                best = Some((s, z));
-            }
+        let mut keep = |p: Point| {
+            let kept = score(p)
+                .filter(|&(s, bar)| lex_less(s, best.as_ref().map_or(bar, |b| b.0)))
+                .map(|(s, _)| best = Some((s, with_depth(&out.z, j, p.0))));
+            kept.is_some()
         };
         let flown = (&head, &at_j, j);
         // The scan's step off the optimum's plateau: (on it, off it).
@@ -145,31 +161,26 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The scan's step into a lower `J` beyond the band (from within
         // it) whose far side is lowest: (within, beyond).
         let mut edge: Option<(Point, Point)> = None;
+        // The scan's first step off the plateau to beyond the band.
+        let (plateau, mut cliff, mut kept) = ((out.j, v_now + tol), None, false);
         for k in 0..self.cfg.scan_points {
             let Some(p) = at_depth(obj, flown, grid(lo, hi, k, self.cfg.scan_points), &out.z)
             else {
                 continue;
             };
-            keep(p, with_depth(&out.z, j, p.0));
+            kept |= keep(p);
             if let Some(q) = prev.filter(|_| !restoring) {
                 edge = lower_edge(edge, (q, p), band);
-                held = off_plateau(held, (q, p), (out.j, v_now + tol), band);
+                held = off_plateau(held, (q, p), plateau, band);
+                cliff = cliff.or_else(|| off_cliff((q, p), plateau, band));
             }
             prev = Some(p);
         }
-        if let Some((mut inside, mut beyond)) = edge {
-            for _ in 0..EDGE {
-                let Some(p) = at_depth(obj, flown, 0.5 * (inside.0 + beyond.0), &out.z) else {
-                    break;
-                };
-                keep(p, with_depth(&out.z, j, p.0));
-                if p.2 <= band {
-                    inside = p;
-                } else {
-                    beyond = p;
-                }
-            }
-        }
+        // (The cliff is the plateau rounds': the held edges' pass comes
+        // after them.)
+        let cliff = cliff.filter(|_| !kept && !later && held.is_none());
+        let steps = (edge, cliff);
+        bisect_steps(obj, (flown, &out.z), steps, (band, plateau), &mut keep);
         best.or_else(|| self.held_edge(obj, flown, held?, (&out.z, tol, later)))
     }
 
@@ -354,6 +365,63 @@ fn off_plateau(
     };
     let lower = off.2 <= band && held.is_none_or(|(_, e)| off.1 < e.1);
     if lower { Some((on, off)) } else { held }
+}
+
+/// The step `(a, b)` between neighbouring scanned points if it leaves the
+/// plateau `plateau` ([`flat`]) to a point beyond `band` (m of
+/// shortfall): `(on, off)`.
+fn off_cliff((a, b): (Point, Point), plateau: (f32, f32), band: f32) -> Option<(Point, Point)> {
+    match (flat(a, plateau), flat(b, plateau)) {
+        (true, false) if b.2 > band => Some((a, b)),
+        (false, true) if a.2 > band => Some((b, a)),
+        _ => None,
+    }
+}
+
+/// The scan's steps bisected, [`EDGE`] times each (one flight of the tail
+/// each; module docs): `edge`, from within `band` (m of shortfall) to a
+/// lower `J` beyond it, for the feasible point nearest the cliff; then,
+/// where no point of it was kept, `cliff`, off the plateau `plateau`
+/// ([`flat`]) to beyond the band, for the first point off the plateau
+/// within it. Each point flown of `z` (tracks before `j` flown as in
+/// `flown`) is offered to `keep`, which tells whether it was kept.
+fn bisect_steps<const K: usize, const N: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    (flown, z): ((&[TrackScore; K], &VehicleState<N>, usize), &[f32; K]),
+    (edge, cliff): (Option<Step>, Option<Step>),
+    (band, plateau): (f32, (f32, f32)),
+    keep: &mut impl FnMut(Point) -> bool,
+) {
+    let mut kept = false;
+    if let Some((mut inside, mut beyond)) = edge {
+        for _ in 0..EDGE {
+            let Some(p) = at_depth(obj, flown, 0.5 * (inside.0 + beyond.0), z) else {
+                break;
+            };
+            kept |= keep(p);
+            if p.2 <= band {
+                inside = p;
+            } else {
+                beyond = p;
+            }
+        }
+    }
+    let Some((mut on, mut off)) = cliff.filter(|_| !kept) else {
+        return;
+    };
+    for _ in 0..EDGE {
+        let Some(p) = at_depth(obj, flown, 0.5 * (on.0 + off.0), z) else {
+            return;
+        };
+        if flat(p, plateau) {
+            on = p;
+        } else if p.2 <= band {
+            keep(p);
+            return;
+        } else {
+            off = p;
+        }
+    }
 }
 
 /// `edge`, or the step `(a, b)` between neighbouring scanned points if one
