@@ -7,6 +7,7 @@ use crate::sim::{Scenario, VehicleState};
 
 use super::budget::Budget;
 use super::certify::{Certificate, Tube};
+use super::jump::Scanned;
 use super::{Plan, PlanError, PlannerConfig};
 
 /// Most candidates of one call aimed again past a knife edge's branch
@@ -23,8 +24,8 @@ pub use super::certify::MAX_TRACKS;
 /// optimizer's history ([`Planner::history`]), the continuation that the
 /// committed depth's safety rests on ([`Planner::continuation`]) and each
 /// declared world's state. Caller-owned: place it in a `static` or on a
-/// task's stack (about 2 KiB + 8 `K` + 60 `N` bytes), so a [`Plan`] stays
-/// small.
+/// task's stack (about 6.5 KiB + 44 `K` + 300 `N` bytes on a 64-bit host:
+/// 7 800 B for `Planner<5>`), so a [`Plan`] stays small.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Planner<const K: usize, const N: usize = 3> {
     pub(super) cfg: PlannerConfig,
@@ -49,6 +50,9 @@ pub struct Planner<const K: usize, const N: usize = 3> {
     /// The later tracks (bits) whose least altitude's row was in
     /// transition where the workspace's last SQP run ended (`probe.rs`).
     pub(super) blended: u32,
+    /// The SQP's plateau scans that kept no point, for the held edges'
+    /// pass (`jump.rs`).
+    pub(super) scanned: Scanned<K>,
 }
 
 #[cfg(feature = "defmt")]
@@ -132,6 +136,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             gaps: [0.0; MAX_TRACKS],
             line_j: 0.0,
             blended: 0,
+            scanned: Scanned::NONE,
         })
     }
 

@@ -142,8 +142,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         tol: f32,
         (skip, far): (u64, bool),
     ) -> Result<(u32, u64), PlanError> {
-        // (No run's rows yet: the last call's must not steer this one.)
+        // (No run's rows yet: the last call's must not steer this one;
+        // nor its plateau scans.)
         self.blended = 0;
+        self.scanned.clear();
         let run = sqp_into(
             obj,
             (z0, 0.0, false),
