@@ -1272,3 +1272,18 @@ fn a_saturated_dive_begins_earlier_on_the_default_vehicle() {
 fn a_plateau_step_to_a_cliff_is_bisected() {
     horizon_within("plateau_cliff", 1.0, 2.003_423e6);
 }
+
+/// A later kink tried where the first lifts nothing (`check_planner.py
+/// --seed 3087 --vehicle tools/reference/vehicles/stiff.toml`,
+/// `unseen_3087_6`): the SQP ended with two rows at one-sided kinks,
+/// track 3's (held by track 2's arrival, its own depth moving nothing,
+/// a climb) and track 4's (a dive saturated from 349 m towards 601.6 m,
+/// holding track 3 at 349.5 m). Only the first was tried, and a climb
+/// frees nothing; the line's `J` was 1.272× the f64 beam search's best
+/// safe plan (1.379 713e6 m³), which flies track 4 at 546 m so that
+/// track 3 flies 20 m deeper. Each kinked row tried in turn
+/// (`src/plan/kink.rs`): 1.0011×.
+#[test]
+fn a_later_kink_is_left_where_the_first_lifts_nothing() {
+    horizon_within("kink_later", 1.02, 1.379_713e6);
+}

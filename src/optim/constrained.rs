@@ -63,7 +63,7 @@ impl<const K: usize> Linearized<K> {
             .map(|((&c, a), &g)| (c, a, g))
     }
 
-    /// The group of the first row that binds at a one-sided kink, if any:
+    /// The groups (bit `g`) of the rows that bind at a one-sided kink:
     /// active (`c <= active`, m), of a group `g` in `1..n` whose own
     /// column `∂c/∂z_g` is exactly zero while an earlier one is not. For
     /// the planner that is a later track's least altitude set while its
@@ -72,12 +72,17 @@ impl<const K: usize> Linearized<K> {
     /// sooner and lifts the sample; a deeper one changes nothing there),
     /// and the linearization shows the side that does nothing, so the
     /// earlier depths look blocked by a row the later depth could free.
-    pub(crate) fn kinked(&self, active: f32, n: usize) -> Option<usize> {
-        self.iter().find_map(|(c, a, g)| {
+    pub(crate) fn kinked(&self, active: f32, n: usize) -> u32 {
+        self.iter().fold(0, |bits, (c, a, g)| {
             let g = usize::from(g);
-            let own = a.get(g).copied()?;
-            let earlier = a.get(..g)?.iter().any(|&v| v != 0.0);
-            (c <= active && g >= 1 && g < n && own == 0.0 && earlier).then_some(g)
+            let own = a.get(g).copied();
+            let earlier = a.get(..g).is_some_and(|e| e.iter().any(|&v| v != 0.0));
+            match group_bit(g) {
+                Some(b) if c <= active && g >= 1 && g < n && own == Some(0.0) && earlier => {
+                    bits | b
+                }
+                _ => bits,
+            }
         })
     }
 
@@ -157,15 +162,18 @@ mod tests {
         let kinked = (0.01, [-0.4, 0.0, 0.0], 1);
         assert_eq!(
             lin(&[(3.0, [0.5, 0.0, 0.0], 0), kinked]).kinked(0.1, 3),
-            Some(1)
+            0b10
         );
         // Not active; its own column moves it; the first track's; no
         // earlier column; a group past the horizon's `n`.
-        assert_eq!(lin(&[(0.5, [-0.4, 0.0, 0.0], 1)]).kinked(0.1, 3), None);
-        assert_eq!(lin(&[(0.01, [-0.4, -0.2, 0.0], 1)]).kinked(0.1, 3), None);
-        assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 0)]).kinked(0.1, 3), None);
-        assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 2)]).kinked(0.1, 3), None);
-        assert_eq!(lin(&[kinked]).kinked(0.1, 1), None);
+        assert_eq!(lin(&[(0.5, [-0.4, 0.0, 0.0], 1)]).kinked(0.1, 3), 0);
+        assert_eq!(lin(&[(0.01, [-0.4, -0.2, 0.0], 1)]).kinked(0.1, 3), 0);
+        assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 0)]).kinked(0.1, 3), 0);
+        assert_eq!(lin(&[(0.0, [0.0, 0.0, 0.0], 2)]).kinked(0.1, 3), 0);
+        assert_eq!(lin(&[kinked]).kinked(0.1, 1), 0);
+        // Two kinked rows: both.
+        let later = (0.0, [-0.1, -0.9, 0.0], 2);
+        assert_eq!(lin(&[kinked, later]).kinked(0.1, 3), 0b110);
     }
 
     #[test]

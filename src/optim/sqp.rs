@@ -191,9 +191,9 @@ pub(crate) struct SqpEnd<const K: usize> {
     /// The ℓ1 merit's final penalty weight `ρ` (m³ of `J` per m of `v`;
     /// 0 when no constraint was ever active).
     pub rho: f32,
-    /// The group of a row active at a one-sided kink at the end
-    /// ([`Linearized::kinked`]), if any.
-    pub kink: Option<usize>,
+    /// The groups (bits) of rows active at a one-sided kink at the end
+    /// ([`Linearized::kinked`]).
+    pub kink: u32,
     /// The groups (bits) of rows active in transition at the end
     /// ([`Linearized::blended`]).
     pub blended: u32,

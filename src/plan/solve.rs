@@ -203,10 +203,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // (The kink is the first run's: a kept plateau restart may have
         // moved the point since; `kink.rs` flies the lift test from where
         // the workspace now stands, and keeps a restart only if better.)
-        if let Some(g) = end.kink
-            && iterations < self.cfg.bfgs.max_iterations
-        {
-            iterations = self.leave_kink(obj, (h, bounds), (g, tol, far), iterations);
+        if end.kink != 0 && iterations < self.cfg.bfgs.max_iterations {
+            iterations = self.leave_kink(obj, (h, bounds), (end.kink, tol, far), iterations);
         }
         self.work.iterations = iterations;
         Ok((iterations, scanned | skip))
