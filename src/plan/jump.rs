@@ -63,6 +63,7 @@
 
 use crate::num::max;
 use crate::optim::Bounds;
+use crate::optim::constrained::group_bit;
 use crate::sim::{TrackScore, VehicleState};
 
 use super::Planner;
@@ -148,11 +149,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
         };
         let mut best: Option<Jump<K>> = None;
-        let mut keep = |p: Point| {
-            let kept = score(p)
-                .filter(|&(s, bar)| lex_less(s, best.as_ref().map_or(bar, |b| b.0)))
-                .map(|(s, _)| best = Some((s, with_depth(&out.z, j, p.0))));
-            kept.is_some()
+        let mut keep = |p: Point| match score(p) {
+            Some((s, bar)) if lex_less(s, best.as_ref().map_or(bar, |b| b.0)) => {
+                best = Some((s, with_depth(&out.z, j, p.0)));
+                true
+            }
+            _ => false,
         };
         let flown = (&head, &at_j, j);
         // The scan's step off the optimum's plateau: (on it, off it).
@@ -374,7 +376,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Scanned<const K: usize> {
     at: ([f32; K], f32, f32),
-    bits: u64,
+    bits: u32,
     held: [Option<Step>; K],
 }
 
@@ -399,7 +401,7 @@ impl<const K: usize> Scanned<K> {
             self.bits = 0;
             self.at = at;
         }
-        if let (Some(bit), Some(slot)) = (bit_of(j), self.held.get_mut(j)) {
+        if let (Some(bit), Some(slot)) = (group_bit(j), self.held.get_mut(j)) {
             self.bits |= bit;
             *slot = held;
         }
@@ -407,14 +409,9 @@ impl<const K: usize> Scanned<K> {
 
     /// Plateau `j`'s step where it was scanned at `at` keeping no point.
     fn held_at(&self, at: ([f32; K], f32, f32), j: usize) -> Option<Option<Step>> {
-        let seen = bit_of(j).is_some_and(|bit| self.bits & bit != 0);
+        let seen = group_bit(j).is_some_and(|bit| self.bits & bit != 0);
         (seen && same(&self.at, &at)).then(|| self.held.get(j).copied().flatten())
     }
-}
-
-/// Bit `j` of a set of plateaus, if `j` fits.
-fn bit_of(j: usize) -> Option<u64> {
-    u32::try_from(j).ok().and_then(|j| 1_u64.checked_shl(j))
 }
 
 /// Whether two points (depths, `J`, shortfall) are the same, bitwise.

@@ -38,6 +38,7 @@
 //! not kept), Monterey 1's one more (a kink that does not dive).
 
 use crate::optim::Bounds;
+use crate::optim::constrained::group_bit;
 
 use super::Planner;
 use super::objective::{PlanObjective, Stop};
@@ -65,10 +66,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         iterations: u32,
     ) -> u32 {
         let far = far && obj.last_violation <= tol;
-        let kinked = |g: &usize| {
-            let bit = u32::try_from(*g).ok().and_then(|g| kinks.checked_shr(g));
-            bit.is_some_and(|b| b & 1 == 1)
-        };
+        let kinked = |g: &usize| group_bit(*g).is_some_and(|b| kinks & b != 0);
         for g in (1..h).filter(kinked) {
             match self.kink_start(obj, bounds, g, far) {
                 Ok(Some(z)) => {
