@@ -1287,3 +1287,17 @@ fn a_plateau_step_to_a_cliff_is_bisected() {
 fn a_later_kink_is_left_where_the_first_lifts_nothing() {
     horizon_within("kink_later", 1.02, 1.379_713e6);
 }
+
+/// A kink's restart that starts slowly is not given up (`make_lines.py`
+/// seed 5034, `tools/reference/vehicles/integ.toml`, `unseen_5034_2`).
+/// A restart from a kink's move is given up after its second iteration
+/// where it is still above the end it would replace and, at that
+/// iteration's pace, more than ten iterations from it (`kink.rs`). Here
+/// its iterates went 16.4, 13.0, 12.6, 10.9, 9.75 M m³ against the kept
+/// 10.25 M: given up at the second whatever the pace, the line ended
+/// 1.123× the f64 beam search's best safe plan (9.121 193e6 m³); on
+/// pace, 1.0002×.
+#[test]
+fn a_kink_restart_on_pace_goes_on() {
+    horizon_within("kink_slow", 1.01, 9.121_193e6);
+}

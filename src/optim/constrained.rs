@@ -138,6 +138,13 @@ pub(crate) trait Constrained<const K: usize> {
     /// # Errors
     /// As [`Constrained::linearize`].
     fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Self::Error>;
+    /// Whether a run gives up after its `iterations`-th iteration, which
+    /// took `J` from `before` to `j` (m³): never, unless the objective
+    /// says so (a restart kept only where it ends below a value it is far
+    /// from by then, `plan/kink.rs`).
+    fn abandon(&self, _iterations: u32, (_before, _j): (f32, f32)) -> bool {
+        false
+    }
 }
 
 #[cfg(test)]
@@ -194,5 +201,74 @@ mod tests {
         assert_eq!(lin(&[(0.0, [-1.07, 0.0, 0.0], 1)]).blended(0.1, 3), 0);
         assert_eq!(lin(&[(0.0, [-1.0, 0.0, 0.0], 0)]).blended(0.1, 3), 0);
         assert_eq!(lin(&[blended]).blended(0.1, 1), 0);
+    }
+
+    /// Rosenbrock's valley, no constraint rows, its Gauss–Newton matrix
+    /// (of its two residuals); a ceiling at `ceiling` after `probe`
+    /// iterations, if any.
+    struct Valley(Option<(u32, f32)>);
+
+    impl Constrained<2> for Valley {
+        type Error = ();
+        fn linearize(&mut self, z: &[f32; 2], _: bool, out: &mut Linearized<2>) -> Result<(), ()> {
+            let [x, y] = *z;
+            (out.j, out.infeasibility) = self.value(z)?;
+            out.grad = [
+                -400.0 * x * (y - x * x) - 2.0 * (1.0 - x),
+                200.0 * (y - x * x),
+            ];
+            // Residuals 10 (y − x²) and 1 − x: J = r ᵀ r.
+            let r = [[-20.0 * x, 10.0], [-1.0, 0.0]];
+            out.gn = [[0.0; 2]; 2];
+            for (i, row) in out.gn.iter_mut().enumerate() {
+                for (k, v) in row.iter_mut().enumerate() {
+                    *v = 2.0 * (r[0][i] * r[0][k] + r[1][i] * r[1][k]);
+                }
+            }
+            Ok(())
+        }
+        fn value(&mut self, z: &[f32; 2]) -> Result<(f32, f32), ()> {
+            let [x, y] = *z;
+            Ok((
+                100.0 * (y - x * x) * (y - x * x) + (1.0 - x) * (1.0 - x),
+                0.0,
+            ))
+        }
+        fn abandon(&self, iterations: u32, (_, j): (f32, f32)) -> bool {
+            self.0
+                .is_some_and(|(probe, c)| iterations == probe && j >= c)
+        }
+    }
+
+    /// The SQP from `(−1.2, 1)` with `ceiling`: its outcome and end.
+    fn valley(ceiling: Option<(u32, f32)>) -> (super::super::Outcome<2>, bool) {
+        let (z0, bounds) = ([-1.2, 1.0], super::super::Bounds::uniform(-5.0, 5.0));
+        let mut out = super::super::Outcome::at(&z0);
+        let cfg = super::super::BfgsConfig::default();
+        let end = super::super::sqp::sqp_into(
+            &mut Valley(ceiling),
+            (&z0, 0.0, false),
+            (&bounds, 2),
+            &cfg,
+            1e-3,
+            &mut out,
+        )
+        .unwrap();
+        (out, end.left.is_some())
+    }
+
+    #[test]
+    fn a_run_gives_up_where_its_objective_abandons_it() {
+        // Without a ceiling, or one it is below at the probe: on to the
+        // valley's floor, (1, 1).
+        let (free, _) = valley(None);
+        assert!(free.iterations > 2 && free.j < 1e-3, "{free:?}");
+        assert_eq!(valley(Some((2, 1e6))).0.iterations, free.iterations);
+        // A ceiling below its second iterate: it stops there.
+        let (given_up, left) = valley(Some((2, 1e-3)));
+        assert_eq!(given_up.iterations, 2);
+        assert_eq!(given_up.history.len(), 3);
+        assert_eq!(given_up.status, super::super::Status::MaxIterations);
+        assert!(!left);
     }
 }

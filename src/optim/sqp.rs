@@ -147,11 +147,12 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
     let _ = out.history.push(run.lin.j);
     let mut best = BestFeasible::default();
     best.see(&run.z, &run.lin, feas_tol);
+    let mut abandoned = false;
     let status = loop {
         if run.iterations >= cfg.max_iterations {
             break Status::MaxIterations;
         }
-        let before = run.iterations;
+        let (before, j_before) = (run.iterations, run.lin.j);
         let stop = run.iterate(obj, (bounds, n), cfg, feas_tol);
         let stop = run.unstuck(obj, (bounds, n), stop, (feas_tol, cfg.max_iterations));
         // One value per completed iteration, the last included.
@@ -161,6 +162,10 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         }
         if let Some(stop) = stop {
             break stop;
+        }
+        if obj.abandon(run.iterations, (j_before, run.lin.j)) {
+            abandoned = true;
+            break Status::MaxIterations;
         }
     };
     let (left, left_j) = (run.z, run.lin.j);
@@ -180,7 +185,8 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
         blended: run.lin.blended(kink_band(&run.lin, feas_tol), n),
         returned,
-        left: (returned && left_j < run.lin.j).then_some(left),
+        // (Given up: no follow-up from where it left.)
+        left: (returned && !abandoned && left_j < run.lin.j).then_some(left),
         sliver: status == Status::Converged && run.sliver && !returned,
     })
 }

@@ -70,7 +70,20 @@ pub(super) struct PlanObjective<'a, const N: usize> {
     /// [`SECANT_STEP`] apart instead of tangents
     /// ([`PlanObjective::secant_rows`]).
     pub secant: bool,
+    /// A restart's ceiling, m³: the SQP gives up after its
+    /// [`CEILING_PROBE`]-th iteration where its iterate's `J` is not below
+    /// it and, at that iteration's pace, would take more than
+    /// [`CEILING_PACE`] more to get there (`kink.rs`); none: never.
+    pub ceiling: Option<f32>,
 }
+
+/// The iteration after which a run with a [`PlanObjective::ceiling`]
+/// is judged.
+pub(super) const CEILING_PROBE: u32 = 2;
+
+/// Iterations, at the probe's pace, within which a run above its
+/// [`PlanObjective::ceiling`] must be able to reach it to go on.
+pub(super) const CEILING_PACE: f32 = 10.0;
 
 /// The step of the constraint rows' secants, m: past the teeth of a
 /// least altitude where the depth loop integrates (a few centimetres
@@ -109,6 +122,7 @@ impl<'a, const N: usize> PlanObjective<'a, N> {
             band: f32::INFINITY,
             gaps: &[],
             secant: false,
+            ceiling: None,
         }
     }
 }
@@ -444,6 +458,16 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
     fn value(&mut self, z: &[f32; K]) -> Result<(f32, f32), Stop> {
         let scores = self.flight(z)?;
         self.value_of(&scores)
+    }
+
+    /// At the [`PlanObjective::ceiling`]'s probe, an iterate not below it
+    /// that its last iteration's decrease (a rise included) would not take
+    /// there in [`CEILING_PACE`] more (nor a `J` that is not a number).
+    fn abandon(&self, iterations: u32, (before, j): (f32, f32)) -> bool {
+        self.ceiling.is_some_and(|c| {
+            let on_pace = j < c || j - c <= CEILING_PACE * (before - j);
+            iterations == CEILING_PROBE && !on_pace
+        })
     }
 }
 
