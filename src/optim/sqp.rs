@@ -106,7 +106,9 @@ const STALLS: u32 = 5;
 /// merit weight to start from (m³/m; 0 learns it from the multipliers).
 /// `careful`: the QP also takes the rows beyond the band its step would
 /// cross (module docs). A run that ends infeasible or worse than its best
-/// feasible iterate goes back to that iterate (`best.rs`). Returns the
+/// feasible iterate goes back to that iterate (`best.rs`); one its
+/// objective gives up ([`Constrained::abandon`]) stops there, as at the
+/// iteration cap, with no `left` to follow up from. Returns the
 /// ℓ1 merit's final penalty weight and any row active at a one-sided kink
 /// at the end ([`SqpEnd`]).
 ///
@@ -206,7 +208,8 @@ pub(crate) struct SqpEnd<const K: usize> {
     /// Whether the run went back to its best feasible iterate
     /// (`best.rs`).
     pub returned: bool,
-    /// Where it ended before it went back, if its `J` was lower there.
+    /// Where it ended before it went back, if its `J` was lower there (not
+    /// where its objective gave it up).
     pub left: Option<[f32; K]>,
     /// Whether it converged on a step that the line search cut below
     /// [`SLIVER`] of the QP's: the metric that chose the step may be out
