@@ -1186,7 +1186,7 @@ fn a_cold_kink_escape_moves_as_far_as_the_dive_needs() {
 /// points (97 m apart) read 126.9 m flat and 223.5 m infeasible, and the
 /// cold call committed 30.2 m: line `J` 1.4135e7 m³, 1.074× the f64 beam
 /// search's best safe plan (1.316275e7 m³, track 1 at 180.8 m). With the
-/// scan's step into the cliff bisected (`jump.rs`), 0.995×. Bound 1.02×:
+/// scan's step into the cliff bisected (`plan/jump/`), 0.995×. Bound 1.02×:
 /// the checker's 1.10× passed this line before.
 #[test]
 fn a_plateau_scan_finds_the_window_before_a_cliff() {
@@ -1263,7 +1263,7 @@ fn a_stalled_infeasible_horizon_stops() {
 /// the cold call kept its local optimum: the line's `J` 5.6588e6 m³,
 /// 1.51× the f64 beam search's best safe plan (3.73824e6 m³: 682.9,
 /// 925.4, 758.1, 1 144.9, 1 100.1 m). The edge steps further off now
-/// (`plan/jump.rs`): 1.0027×.
+/// (`plan/jump/`): 1.0027×.
 #[test]
 fn a_later_track_held_through_a_plateau_is_freed_further_off() {
     horizon_within("freed_far", 1.01, 3.738_24e6);

@@ -220,7 +220,7 @@ fn a_low_authority_vehicle_starts_again_wider() {
 /// no trade between the two, and the plateau scan of `z_4` alone finds no
 /// lower `J`: the line's `J` 3.4331e6 m³, 1.54× the f64 beam search's best
 /// safe plan (2.2318e6 m³: 736.9, 507.3, 718.9, 860.6 m). Restarted from
-/// the plateau's edge (`plan/jump.rs`, `held_edge`): 1.0005×. The
+/// the plateau's edge (`plan/jump/`, `held_edge`): 1.0005×. The
 /// checker's bound is 1.10×.
 #[test]
 fn a_track_held_from_a_plateau_is_freed_at_its_edge() {
@@ -266,7 +266,7 @@ fn a_third_plateau_round_frees_a_depth_the_first_two_left() {
 /// 2's depth (173 m). The line's `J` 7.1394e6 m³, 1.24× the f64 beam
 /// search's best safe plan (5.7627e6 m³: 255.8, 219.3, 597.8, 959.5 m).
 /// The cold call's last escape restarts from track 3's plateau edge,
-/// where track 4 is freed (`plan/jump.rs`, `held_last`): 1.0005×. The
+/// where track 4 is freed (`plan/jump/`, `held_last`): 1.0005×. The
 /// checker's bound is 1.10×.
 #[test]
 fn a_later_track_held_past_a_plateau_is_freed_last() {
@@ -533,7 +533,7 @@ fn a_freed_held_edge_is_ranked_before_an_unfreed_one() {
 /// the f64 beam search's best safe plan (2.09871e7 m³: 1 195.1, 1 007.9,
 /// 866.9, 729.0, 607.7 m). The points less infeasible than the optimum
 /// are now weighed by `J` with their shortfall priced as the non-restoring
-/// scan prices it (`plan/jump.rs`): 1.003×.
+/// scan prices it (`plan/jump/`): 1.003×.
 #[test]
 fn a_restoring_plateau_scan_weighs_j_against_the_shortfall() {
     horizon_within("restore_merit", 1.01, 2.098_709e7);
@@ -1267,7 +1267,7 @@ fn a_saturated_dive_begins_earlier_on_the_default_vehicle() {
 /// 402 m flat and 538 m 141 m short with a higher `J`, and the line's `J`
 /// was 1.109× the f64 beam search's best safe plan (2.003 423e6 m³), which
 /// flies track 2 at 445 m. The step off the plateau bisected
-/// (`src/plan/jump.rs`, `bisect_steps`): 0.986×.
+/// (`src/plan/jump/steps.rs`, `bisect_steps`): 0.986×.
 #[test]
 fn a_plateau_step_to_a_cliff_is_bisected() {
     horizon_within("plateau_cliff", 1.0, 2.003_423e6);
@@ -1300,4 +1300,20 @@ fn a_later_kink_is_left_where_the_first_lifts_nothing() {
 #[test]
 fn a_kink_restart_on_pace_goes_on() {
     horizon_within("kink_slow", 1.01, 9.121_193e6);
+}
+
+/// A plateau's first step off it to a lower `J` short of its targets,
+/// within the band, is bisected for a start (`check_planner.py --seed
+/// 3113 --vehicle tools/reference/vehicles/twoki.toml`, `unseen_3113_7`).
+/// Track 1 dived saturated for `z_1` shallower than about 155 m, where
+/// the SQP stopped (138.2 m); the scan read 223.4 m 13 m short (within
+/// the band of 15 m) at a `J` 57 000 m³ lower, with no point kept, and
+/// track 1 is not held by an earlier depth, so no held edge was sought.
+/// Between them, near 190–200 m, every track clears and `J` is lower: the
+/// line's `J` was 1.049× the f64 beam search's best safe plan
+/// (2.551 272e6 m³, track 1 at 185.1 m). The step bisected
+/// (`src/plan/jump/steps.rs`, `bisect_dip`): 1.0015×.
+#[test]
+fn a_plateau_dip_short_within_the_band_is_bisected() {
+    horizon_within("plateau_dip", 1.01, 2.551_272e6);
 }

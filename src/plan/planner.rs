@@ -51,7 +51,7 @@ pub struct Planner<const K: usize, const N: usize = 3> {
     /// transition where the workspace's last SQP run ended (`probe.rs`).
     pub(super) blended: u32,
     /// The SQP's plateau scans that kept no point, for the held edges'
-    /// pass (`jump.rs`).
+    /// pass (`jump/`).
     pub(super) scanned: Scanned<K>,
 }
 

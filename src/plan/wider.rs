@@ -52,7 +52,7 @@
 //!
 //! The same restart runs where a feasible end's first depth has no
 //! gradient at all (a saturated dive or climb through its whole track):
-//! the SQP cannot move it, and the plateau escape (`jump.rs`) moves it
+//! the SQP cannot move it, and the plateau escape (`jump/`) moves it
 //! with the later depths held. On `check_planner.py --seed 2638 --vehicle
 //! tools/reference/vehicles/integ.toml` (`unseen_2638_7`) track 1 kept
 //! the scan's 768.7 m through every iteration, where the best safe plan
@@ -119,7 +119,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// A cold call's escapes after its SQP, in order: the wide beam where
     /// the SQP ended infeasible by more than the band; then, without
     /// declared uncertainty, the short end repaired (module docs), the
-    /// lift (`lift/`) and the held edge (`jump.rs`, `held_last`); then the
+    /// lift (`lift/`) and the held edge (`jump/`, `held_last`); then the
     /// sink (`sink.rs`); then the probe of a held track whose dive ends
     /// (`probe.rs`); then the wide beam where a track of that end is held
     /// far above its bottom or its first depth has no gradient, and where
@@ -224,7 +224,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         again.unwrap_or(iterations)
     }
 
-    /// The lift (`lift/`), then the held edge (`jump.rs`, `held_last`),
+    /// The lift (`lift/`), then the held edge (`jump/`, `held_last`),
     /// after `iterations` so far; returns the iterations so far.
     fn lift_then_held(
         &mut self,

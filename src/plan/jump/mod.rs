@@ -28,6 +28,23 @@
 //! lines 5 move (`unseen_5034_0` 0.990×; one higher, by 2e-5), +0.5
 //! flights a line; the 18 shared runs keep their plans and flights.
 //!
+//! The window can lie between the plateau and a scanned point within the
+//! band, short of its targets, whose `J` is lower: on `check_planner.py
+//! --seed 3113 --vehicle tools/reference/vehicles/twoki.toml`
+//! (`unseen_3113_7`) track 1 dived saturated for `z_1` shallower than
+//! about 155 m, where the SQP stopped (138.2 m); the scan read 223.4 m
+//! 13 m short (the band is 15 m) at a `J` 57 000 m³ lower, priced out by
+//! its shortfall, and track 1 is held by no earlier depth, so no held
+//! edge was sought (below). Near 190–200 m every track clears and `J` is
+//! lower; the line's `J` was 1.049× the f64 best safe plan's. Where the
+//! scan keeps no point and no held edge is found, its first such step
+//! (`Steps::dip`) is bisected [`EDGE`] times towards the dip for the
+//! start of least score (`bisect_dip`): 1.0015×. Not in the held edges'
+//! pass. On the 304 random lines one moves (`unseen_5024_1`, 0.13 %
+//! lower), 0.2 flights a line more; the 18 shared runs keep their plans,
+//! Monterey 1's cold call flies 3 more (a dip whose bisection keeps no
+//! point).
+//!
 //! From an infeasible optimum, the scan weighs the points less infeasible
 //! than it by `J` plus their shortfall priced at [`RESTORE_SHARE`] of the
 //! merit weight, as it weighs a feasible optimum's. It took the point of
@@ -66,31 +83,21 @@ use crate::optim::Bounds;
 use crate::optim::constrained::group_bit;
 use crate::sim::{TrackScore, VehicleState};
 
+mod steps;
+
+use steps::{EDGE, Point, Step, Steps, at_depth, bisect_dip, bisect_steps, flat, scan_steps};
+
 use super::Planner;
 use super::objective::PlanObjective;
-use super::scan::{grid, reach_from, with_depth};
+use super::scan::{reach_from, with_depth};
 use super::solve::{RESTORE_SHARE, lex_less};
-
-/// Bisections of a scan's step from a point within the band to one
-/// beyond it with a lower `J`, or off the plateau to beyond the band.
-const EDGE: u32 = 3;
 
 /// Steps further off a plateau's edge (the band `h_r − h_a`, doubling)
 /// that [`Planner::held_edge`] tries for a later track held just off it.
 const FREE_STEPS: u32 = 3;
 
-/// A scanned point's `J` within this share of the optimum's is on its
-/// plateau.
-const FLAT: f32 = 1e-5;
-
 /// A merit weight (m³/m) that prices any shortfall out of a scan.
 const PRICED_OUT: f32 = 1e30;
-
-/// A scanned point: `(z_j, Σ J, v)`, m, m³, m.
-type Point = (f32, f32, f32);
-
-/// A step between two scanned points.
-type Step = (Point, Point);
 
 /// A restart candidate: its score (shortfall, `J`) and its depths.
 type Jump<const K: usize> = ((f32, f32), [f32; K]);
@@ -156,38 +163,36 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             }
             _ => false,
         };
-        let flown = (&head, &at_j, j);
-        // The scan's step off the optimum's plateau: (on it, off it).
-        let mut held: Option<(Point, Point)> = None;
-        let mut prev: Option<Point> = None;
-        // The scan's step into a lower `J` beyond the band (from within
-        // it) whose far side is lowest: (within, beyond).
-        let mut edge: Option<(Point, Point)> = None;
-        // The scan's first step off the plateau to beyond the band.
-        let (plateau, mut cliff, mut kept) = ((out.j, v_now + tol), None, false);
-        for k in 0..self.cfg.scan_points {
-            let Some(p) = at_depth(obj, flown, grid(lo, hi, k, self.cfg.scan_points), &out.z)
-            else {
-                continue;
-            };
-            kept |= keep(p);
-            if let Some(q) = prev.filter(|_| !restoring) {
-                edge = lower_edge(edge, (q, p), band);
-                held = off_plateau(held, (q, p), plateau, band);
-                cliff = cliff.or_else(|| off_cliff((q, p), plateau, band));
-            }
-            prev = Some(p);
-        }
-        // (The cliff is the plateau rounds': the held edges' pass comes
-        // after them.)
-        let cliff = cliff.filter(|_| !kept && !later && held.is_none());
-        let steps = (edge, cliff);
-        bisect_steps(obj, (flown, &out.z), steps, (band, plateau), &mut keep);
+        let (flown, plateau) = ((&head, &at_j, j), (out.j, v_now + tol));
+        let reach = (lo, hi, self.cfg.scan_points);
+        let sides = (plateau, band, restoring);
+        let (steps, kept) = scan_steps(obj, (flown, &out.z), reach, sides, &mut keep);
+        // (The cliff and the dip are the plateau rounds': the held edges'
+        // pass comes after them.)
+        let Steps { held, edge, .. } = steps;
+        let cliff = steps.cliff.filter(|_| !kept && !later && held.is_none());
+        bisect_steps(
+            obj,
+            (flown, &out.z),
+            (edge, cliff),
+            (band, plateau),
+            &mut keep,
+        );
         let at = (out.z, out.j, v_now);
         if best.is_none() && !later {
             self.scanned.note(at, j, held);
         }
-        best.or_else(|| self.held_edge(obj, flown, held?, (&at.0, tol, later)))
+        let dip = steps.dip.filter(|_| !kept && !later);
+        let found = best.or_else(|| self.held_edge(obj, flown, held?, (&at.0, tol, later)));
+        let kept = |p: Point| {
+            score(p)
+                .filter(|&(s, bar)| lex_less(s, bar))
+                .map(|(s, _)| s)
+        };
+        found.or_else(|| {
+            let (s, p) = bisect_dip(obj, (flown, &at.0), (dip?, plateau), kept)?;
+            Some((s, with_depth(&at.0, j, p.0)))
+        })
     }
 
     /// [`Planner::held_edge`] for the held edges' pass (`later`) from the
@@ -422,119 +427,6 @@ fn same<const K: usize>(a: &([f32; K], f32, f32), b: &([f32; K], f32, f32)) -> b
             .iter()
             .zip(&b.0)
             .all(|(x, y)| x.to_bits() == y.to_bits())
-}
-
-/// The point `z_j = zj` (m) of `z`, whose tracks before `j` flew `head`
-/// and left `at_j`: one flight of the tail; `None` if it failed.
-fn at_depth<const K: usize, const N: usize>(
-    obj: &mut PlanObjective<'_, N>,
-    (head, at_j, j): (&[TrackScore; K], &VehicleState<N>, usize),
-    zj: f32,
-    z: &[f32; K],
-) -> Option<Point> {
-    let (jz, v) = obj
-        .tail_value(head, (at_j, j), &with_depth(z, j, zj))
-        .ok()?;
-    Some((zj, jz, v))
-}
-
-/// Whether point `p` is on the plateau of `J` `j` (m³): its `J` within
-/// [`FLAT`] of it, its shortfall at most `v` (m).
-fn flat(p: Point, (j, v): (f32, f32)) -> bool {
-    libm::fabsf(p.1 - j) <= FLAT * j && p.2 <= v
-}
-
-/// `held`, or the step `(a, b)` between neighbouring scanned points if it
-/// leaves the plateau `plateau` ([`flat`]) to a point within `band` (m of
-/// shortfall) whose `J` is lower than `held`'s off side: `(on, off)`.
-fn off_plateau(
-    held: Option<(Point, Point)>,
-    (a, b): (Point, Point),
-    plateau: (f32, f32),
-    band: f32,
-) -> Option<(Point, Point)> {
-    let (on, off) = match (flat(a, plateau), flat(b, plateau)) {
-        (true, false) => (a, b),
-        (false, true) => (b, a),
-        _ => return held,
-    };
-    let lower = off.2 <= band && held.is_none_or(|(_, e)| off.1 < e.1);
-    if lower { Some((on, off)) } else { held }
-}
-
-/// The step `(a, b)` between neighbouring scanned points if it leaves the
-/// plateau `plateau` ([`flat`]) to a point beyond `band` (m of
-/// shortfall): `(on, off)`.
-fn off_cliff((a, b): (Point, Point), plateau: (f32, f32), band: f32) -> Option<(Point, Point)> {
-    match (flat(a, plateau), flat(b, plateau)) {
-        (true, false) if b.2 > band => Some((a, b)),
-        (false, true) if a.2 > band => Some((b, a)),
-        _ => None,
-    }
-}
-
-/// The scan's steps bisected, [`EDGE`] times each (one flight of the tail
-/// each; module docs): `edge`, from within `band` (m of shortfall) to a
-/// lower `J` beyond it, for the feasible point nearest the cliff; then,
-/// where no point of it was kept, `cliff`, off the plateau `plateau`
-/// ([`flat`]) to beyond the band, for the first point off the plateau
-/// within it. Each point flown of `z` (tracks before `j` flown as in
-/// `flown`) is offered to `keep`, which tells whether it was kept.
-fn bisect_steps<const K: usize, const N: usize>(
-    obj: &mut PlanObjective<'_, N>,
-    (flown, z): ((&[TrackScore; K], &VehicleState<N>, usize), &[f32; K]),
-    (edge, cliff): (Option<Step>, Option<Step>),
-    (band, plateau): (f32, (f32, f32)),
-    keep: &mut impl FnMut(Point) -> bool,
-) {
-    let mut kept = false;
-    if let Some((mut inside, mut beyond)) = edge {
-        for _ in 0..EDGE {
-            let Some(p) = at_depth(obj, flown, 0.5 * (inside.0 + beyond.0), z) else {
-                break;
-            };
-            kept |= keep(p);
-            if p.2 <= band {
-                inside = p;
-            } else {
-                beyond = p;
-            }
-        }
-    }
-    let Some((mut on, mut off)) = cliff.filter(|_| !kept) else {
-        return;
-    };
-    for _ in 0..EDGE {
-        let Some(p) = at_depth(obj, flown, 0.5 * (on.0 + off.0), z) else {
-            return;
-        };
-        if flat(p, plateau) {
-            on = p;
-        } else if p.2 <= band {
-            keep(p);
-            return;
-        } else {
-            off = p;
-        }
-    }
-}
-
-/// `edge`, or the step `(a, b)` between neighbouring scanned points if one
-/// is within `band` (m of shortfall) and the other beyond it with a lower
-/// `J`, lower than `edge`'s far side.
-fn lower_edge(
-    edge: Option<(Point, Point)>,
-    (a, b): (Point, Point),
-    band: f32,
-) -> Option<(Point, Point)> {
-    let step = match (a.2 <= band, b.2 <= band) {
-        (true, false) => (a, b),
-        (false, true) => (b, a),
-        _ => return edge,
-    };
-    let (inside, beyond) = step;
-    let lower = beyond.1 < inside.1 && edge.is_none_or(|(_, e)| beyond.1 < e.1);
-    if lower { Some(step) } else { edge }
 }
 
 #[cfg(test)]
