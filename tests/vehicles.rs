@@ -1317,3 +1317,17 @@ fn a_kink_restart_on_pace_goes_on() {
 fn a_plateau_dip_short_within_the_band_is_bisected() {
     horizon_within("plateau_dip", 1.01, 2.551_272e6);
 }
+
+/// A restart's end a little short, where each short track is held by the
+/// depth before it, is repaired across the tracks (`check_planner.py
+/// --seed 3098 --vehicle tools/reference/vehicles/twoki.toml`,
+/// `unseen_3098_7`). A lift's restart ended at 7.906e6 m³, 4 cm short on
+/// tracks 4 and 5, against the SQP's 8.27e6; track 4 was held by depth 3
+/// and track 5 by depth 4, so raising each short track's own depth lifted
+/// nothing and the end was dropped: the line ended 1.042× the f64 beam
+/// search's best safe plan (7.836 746e6 m³). Raised across, track by track
+/// (`src/plan/restart.rs`, `repaired_short`): 1.0025×.
+#[test]
+fn a_short_end_held_across_the_tracks_is_repaired() {
+    horizon_within("short_across", 1.01, 7.836_746e6);
+}
