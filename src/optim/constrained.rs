@@ -149,6 +149,8 @@ pub(crate) trait Constrained<const K: usize> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::sqp::sqp_into;
+    use super::super::{BfgsConfig, Bounds, Outcome, Status};
     use super::*;
 
     /// Rows `(c, ∂c/∂z, group)` of a three-depth linearization.
@@ -241,11 +243,11 @@ mod tests {
     }
 
     /// The SQP from `(−1.2, 1)` with `ceiling`: its outcome and end.
-    fn valley(ceiling: Option<(u32, f32)>) -> (super::super::Outcome<2>, bool) {
-        let (z0, bounds) = ([-1.2, 1.0], super::super::Bounds::uniform(-5.0, 5.0));
-        let mut out = super::super::Outcome::at(&z0);
-        let cfg = super::super::BfgsConfig::default();
-        let end = super::super::sqp::sqp_into(
+    fn valley(ceiling: Option<(u32, f32)>) -> (Outcome<2>, bool) {
+        let (z0, bounds) = ([-1.2, 1.0], Bounds::uniform(-5.0, 5.0));
+        let mut out = Outcome::at(&z0);
+        let cfg = BfgsConfig::default();
+        let end = sqp_into(
             &mut Valley(ceiling),
             (&z0, 0.0, false),
             (&bounds, 2),
@@ -268,7 +270,7 @@ mod tests {
         let (given_up, left) = valley(Some((2, 1e-3)));
         assert_eq!(given_up.iterations, 2);
         assert_eq!(given_up.history.len(), 3);
-        assert_eq!(given_up.status, super::super::Status::MaxIterations);
+        assert_eq!(given_up.status, Status::MaxIterations);
         assert!(!left);
     }
 }

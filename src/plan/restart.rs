@@ -4,6 +4,7 @@
 //! little short of its targets once more from its end repaired
 //! ([`repaired`], or across the tracks: [`repaired_short`]).
 
+use crate::optim::constrained::Constrained;
 use crate::optim::sqp::sqp_into;
 use crate::optim::{BfgsConfig, Bounds};
 use crate::sim::TrackScore;
@@ -256,7 +257,7 @@ fn repaired_short<const N: usize, const K: usize>(
         let short = short_track(obj, &scores, false)?;
         z = lifted_across(obj, &z, bounds, short, tol)?;
     }
-    let (_, v) = horizon_value(obj, &z)?;
+    let (_, v) = obj.value(&z).ok()?;
     (v <= tol).then_some(z)
 }
 
@@ -308,13 +309,4 @@ fn lifted_across<const N: usize, const K: usize>(
     let (j, rate) = best.filter(|&(_, r)| r >= ACROSS_RATE)?;
     let raised = crate::num::max(*z.get(j)? - (short + tol) / rate, *bounds.lo.get(j)?);
     Some(with_depth(z, j, raised))
-}
-
-/// `(J, v)` of a plain flight of the horizon at `z` (m³, m).
-fn horizon_value<const N: usize, const K: usize>(
-    obj: &mut PlanObjective<'_, N>,
-    z: &[f32; K],
-) -> Option<(f32, f32)> {
-    let scores = obj.flight(z).ok()?;
-    obj.value_of(&scores).ok()
 }

@@ -149,7 +149,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if restoring {
                 let merit = jz + price * max(v - tol, 0.0);
                 (v < v_now - tol).then_some(((0.0, merit), (0.0, f32::INFINITY)))
-            } else if v <= band && jz + RESTORE_SHARE * rho * v < threshold {
+            } else if v <= band && jz + price * v < threshold {
                 Some(((0.0, jz), (0.0, threshold)))
             } else {
                 None
@@ -184,13 +184,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         let dip = steps.dip.filter(|_| !kept && !later);
         let found = best.or_else(|| self.held_edge(obj, flown, held?, (&at.0, tol, later)));
-        let kept = |p: Point| {
+        // (A dip's point is a start where the scan would have kept it.)
+        let start = |p: Point| {
             score(p)
                 .filter(|&(s, bar)| lex_less(s, bar))
                 .map(|(s, _)| s)
         };
         found.or_else(|| {
-            let (s, p) = bisect_dip(obj, (flown, &at.0), (dip?, plateau), kept)?;
+            let (s, p) = bisect_dip(obj, (flown, &at.0), (dip?, plateau), start)?;
             Some((s, with_depth(&at.0, j, p.0)))
         })
     }

@@ -70,31 +70,31 @@ pub(super) fn flat(p: Point, (j, v): (f32, f32)) -> bool {
     libm::fabsf(p.1 - j) <= FLAT * j && p.2 <= v
 }
 
-/// `held`, or the step `(a, b)` between neighbouring scanned points if it
-/// leaves the plateau `plateau` ([`flat`]) to a point within `band` (m of
-/// shortfall) whose `J` is lower than `held`'s off side: `(on, off)`.
-fn off_plateau(
-    held: Option<(Point, Point)>,
-    (a, b): (Point, Point),
-    plateau: (f32, f32),
-    band: f32,
-) -> Option<(Point, Point)> {
-    let (on, off) = match (flat(a, plateau), flat(b, plateau)) {
-        (true, false) => (a, b),
-        (false, true) => (b, a),
-        _ => return held,
-    };
-    let lower = off.2 <= band && held.is_none_or(|(_, e)| off.1 < e.1);
-    if lower { Some((on, off)) } else { held }
+/// `held`, or `step` between neighbouring scanned points if it leaves the
+/// plateau `plateau` ([`flat`]) to a point within `band` (m of shortfall)
+/// whose `J` is lower than `held`'s off side: `(on, off)`.
+fn off_plateau(held: Option<Step>, step: Step, plateau: (f32, f32), band: f32) -> Option<Step> {
+    match leaving(step, plateau) {
+        Some((on, off)) if off.2 <= band && held.is_none_or(|(_, e)| off.1 < e.1) => {
+            Some((on, off))
+        }
+        _ => held,
+    }
 }
 
-/// The step `(a, b)` between neighbouring scanned points if it leaves the
-/// plateau `plateau` ([`flat`]) to a point beyond `band` (m of
-/// shortfall): `(on, off)`.
-fn off_cliff((a, b): (Point, Point), plateau: (f32, f32), band: f32) -> Option<(Point, Point)> {
+/// `step` between neighbouring scanned points if it leaves the plateau
+/// `plateau` ([`flat`]) to a point beyond `band` (m of shortfall):
+/// `(on, off)`.
+fn off_cliff(step: Step, plateau: (f32, f32), band: f32) -> Option<Step> {
+    leaving(step, plateau).filter(|(_, off)| off.2 > band)
+}
+
+/// The step `(a, b)` as `(on, off)` where exactly one of its points is
+/// on the plateau `plateau` ([`flat`]).
+fn leaving((a, b): Step, plateau: (f32, f32)) -> Option<Step> {
     match (flat(a, plateau), flat(b, plateau)) {
-        (true, false) if b.2 > band => Some((a, b)),
-        (false, true) if a.2 > band => Some((b, a)),
+        (true, false) => Some((a, b)),
+        (false, true) => Some((b, a)),
         _ => None,
     }
 }
@@ -171,17 +171,13 @@ pub(super) fn bisect_steps<const K: usize, const N: usize>(
     }
 }
 
-/// The step `(a, b)` between neighbouring scanned points if it leaves the
-/// plateau `plateau` ([`flat`]) to a point short of its targets (beyond
-/// the plateau's shortfall) within `band` (m of shortfall) whose `J` is
-/// lower than the plateau's: `(on, off)`.
-fn off_dip((a, b): Step, plateau: (f32, f32), band: f32) -> Option<Step> {
-    let (on, off) = match (flat(a, plateau), flat(b, plateau)) {
-        (true, false) => (a, b),
-        (false, true) => (b, a),
-        _ => return None,
-    };
-    (off.2 > plateau.1 && off.2 <= band && off.1 < plateau.0).then_some((on, off))
+/// `step` between neighbouring scanned points if it leaves the plateau
+/// `plateau` ([`flat`]) to a point short of its targets (beyond the
+/// plateau's shortfall) within `band` (m of shortfall) whose `J` is lower
+/// than the plateau's: `(on, off)`.
+fn off_dip(step: Step, plateau: (f32, f32), band: f32) -> Option<Step> {
+    leaving(step, plateau)
+        .filter(|(_, off)| off.2 > plateau.1 && off.2 <= band && off.1 < plateau.0)
 }
 
 /// The step `(on, off)` off the plateau to a lower `J` short of its
@@ -214,11 +210,7 @@ pub(super) fn bisect_dip<const K: usize, const N: usize>(
 /// `edge`, or the step `(a, b)` between neighbouring scanned points if one
 /// is within `band` (m of shortfall) and the other beyond it with a lower
 /// `J`, lower than `edge`'s far side.
-fn lower_edge(
-    edge: Option<(Point, Point)>,
-    (a, b): (Point, Point),
-    band: f32,
-) -> Option<(Point, Point)> {
+fn lower_edge(edge: Option<Step>, (a, b): Step, band: f32) -> Option<Step> {
     let step = match (a.2 <= band, b.2 <= band) {
         (true, false) => (a, b),
         (false, true) => (b, a),
