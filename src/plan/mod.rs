@@ -153,6 +153,7 @@ mod jump;
 mod kink;
 mod knife;
 mod lift;
+mod looks;
 mod objective;
 mod planner;
 mod plateau;
