@@ -1090,6 +1090,22 @@ fn a_later_depth_stuck_above_its_target_is_polished() {
     horizon_within("later_stuck", 1.08, 1.236_588e6);
 }
 
+/// Later depths on a staircase (`check_planner.py --seed 3120 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_3120_6`): the cold call's
+/// SQP converged with tracks 4 and 5 clear of their targets, their
+/// `∂J/∂z` 2.4 and 4.5 m² (a step's flat), where `J` jumps about 90 m³
+/// every 5 to 8 cm of `z_5` on a trend of 1 800 m³/m and `z_4` 4.5 m
+/// deeper with `z_5` 3.7 m shallower is 3.7 % lower; its last iteration
+/// had still taken 1.6e-3 of `J`. No later depth's gradient called the
+/// polish, and the line's `J` was 1.0159× the f64 beam search's best safe
+/// plan (121 538.2 m³). A later depth clear of its target is polished
+/// now also where `J` fell by more than 1e-4 of itself in the SQP's last
+/// iteration (`src/plan/polish.rs`, `stuck_later`): 1.0015×.
+#[test]
+fn later_depths_on_a_staircase_are_polished() {
+    horizon_within("staircase_later", 1.005, 121_538.2);
+}
+
 /// A sink through a saturated dive (`check_planner.py --seed 3004
 /// --vehicle tools/reference/vehicles/fast.toml`, `unseen_3004_0`):
 /// track 1 flew 4 m above its target at 403.8 m, held by track 3 through

@@ -322,6 +322,15 @@ impl<const K: usize> Outcome<K> {
         self.history.truncate(mark.history);
     }
 
+    /// How much the objective fell in the last step its history holds
+    /// (0 with fewer than two values), in the objective's unit.
+    pub(crate) fn last_fall(&self) -> f32 {
+        match self.history.as_slice() {
+            [.., a, b] => a - b,
+            _ => 0.0,
+        }
+    }
+
     /// The first coordinate in `bounds` (a single track's depth, or a
     /// horizon's committed one): its value, the gradient's entry and the
     /// box's bounds on it, if `K > 0`.

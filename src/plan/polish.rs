@@ -145,7 +145,18 @@
 //! and 4 higher (by up to 0.24 %: `unseen_5034_2`, `integ`, 1.0440× →
 //! 1.0466× the f64 best), 2.95 flights a line more; the default vehicle's
 //! depth loop does not integrate, and the 18 shared runs keep their plans
-//! and flights.
+//! and flights. A later depth on a staircase has no such gradient: on
+//! `check_planner.py --seed 3120 --vehicle
+//! tools/reference/vehicles/rate.toml` (`unseen_3120_6`) the cold call
+//! converged with tracks 4 and 5 clear of their targets and `∂J/∂z` of
+//! 2.4 and 4.5 m² (a step's flat: `J` jumps about 90 m³ every 5 to 8 cm
+//! of `z_5` on a trend of 1 800 m³/m), where `z_4` 4.5 m deeper with
+//! `z_5` 3.7 m shallower is 3.7 % lower; the line was 1.0159× the f64
+//! search's best safe plan. So a later depth is polished also where `J`
+//! fell by more than [`SHARE`] of itself in the SQP's last iteration, as
+//! a single track is (1.6e-3 there): 1.0015×. On the 304 random lines 4
+//! move, all lower (to −0.29 %), for 1.8 flights a line more; the 18
+//! shared runs give the same JSON.
 //!
 //! A look's descent reads the trend and ends anywhere on a tooth, up to
 //! a tooth's height above its bottom. Where `J` is small that height is a
@@ -225,11 +236,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         let j0 = w.j;
         let share = SHARE * libm::fabsf(j0);
-        // The last iteration's decrease of `J`.
-        let fell = match w.history.as_slice() {
-            [.., a, b] => a - b,
-            _ => 0.0,
-        };
+        let fell = w.last_fall();
         if !(libm::fabsf(g0) * STEP > share || fell > share || obj.teeth()) {
             return;
         }
@@ -277,9 +284,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             *floor = min(s.min_altitude(), obj.target_of(t)) - tol;
         }
         let clear = Clear::Floors(floors);
+        let fell = self.work.last_fall();
         let mut j0 = j0;
         for i in 1..h.min(obj.count) {
-            if self.stuck_later(obj, (i, bounds), &end, tol)
+            if self.stuck_later(obj, (i, bounds), (&end, fell), tol)
                 && let (Some(&zi), Some(&lo), Some(&hi)) =
                     (self.work.z.get(i), bounds.lo.get(i), bounds.hi.get(i))
                 && self.polish_from(obj, (i, lo, hi), clear, (zi, j0))
@@ -293,12 +301,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// Whether later depth `i` of the SQP's end (its flight `end`) is
     /// stuck (module docs): its track clears its target by more than
     /// [`PlanObjective::held_slack_teeth`] (m), and its gradient
-    /// predicts more than [`SHARE`] of `J` over [`STEP`].
+    /// predicts more than [`SHARE`] of `J` over [`STEP`] or `J` fell by
+    /// more than that share in the SQP's last iteration (`fell`, m³: a
+    /// staircase).
     fn stuck_later(
         &self,
         obj: &PlanObjective<'_, N>,
         (i, bounds): (usize, &Bounds<K>),
-        end: &[TrackScore; K],
+        (end, fell): (&[TrackScore; K], f32),
         tol: f32,
     ) -> bool {
         let slack = obj.held_slack_teeth(tol);
@@ -311,9 +321,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         ) else {
             return false;
         };
+        let share = SHARE * libm::fabsf(w.j);
         lo < hi
             && s.min_altitude() > obj.target_of(i) + slack
-            && libm::fabsf(g) * STEP > SHARE * libm::fabsf(w.j)
+            && (libm::fabsf(g) * STEP > share || fell > share)
     }
 
     /// The polish's search from a constrained track's boundary `(z, J)`
