@@ -200,6 +200,23 @@ fn a_dip_beside_the_basin_is_looked_past() {
     track_within("polish_again", &UNCONSTRAINED, &premise, 3, 220_499.0);
 }
 
+/// A descent from the polish's first look that ends at its parabola's
+/// vertex short of the basin (`check_planner.py --seed 3162 --vehicle
+/// tools/reference/vehicles/rate.toml`, `unseen_3162_7`, track 4,
+/// constrained, its least altitude 60.14 m whatever the depth near the
+/// basin): from 1 100.62 m the half-metre look and its doubling steps
+/// (1 m, 2 m) put the vertex at 1 102.39 m (39 614.7 m³) on teeth of
+/// about 40 m³, and the looks at 2 and 4 m from there found nothing
+/// lower: 1.0058× the f64 best 39 385.5 m³ (1 103.139 m, from the tool's
+/// tracks 1 to 3), over the checker's 1.005. The half-metre look once
+/// more, after those, finds 1 102.89 m and the descent goes on
+/// (`src/plan/polish.rs`): 1 102.88 m, 1.0015×.
+#[test]
+fn a_vertex_short_of_the_basin_is_looked_past() {
+    let premise = [(0, 995.2895), (1, 1324.8254), (2, 1122.3733)];
+    track_within("tooth_again", &["--mode", "track"], &premise, 3, 39_385.5);
+}
+
 /// A sawtooth whose trend falls into the safe set's boundary
 /// (`check_planner.py --seed 2669 --vehicle
 /// tools/reference/vehicles/integ.toml`, `unseen_2669_0`, track 1,
