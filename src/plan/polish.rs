@@ -213,8 +213,7 @@ use crate::optim::{Bounds, First};
 use crate::sim::TrackScore;
 
 use super::Planner;
-use super::looks::Clear;
-use super::looks::{boundary_toward, descend, flown_at, lower_side, settle};
+use super::looks::{Clear, boundary_toward, descend, flown_at, lower_side, settle};
 use super::objective::PlanObjective;
 
 /// The polish's first step, m: many teeth wide, short against a track's

@@ -4,7 +4,6 @@
 //! little short of its targets once more from its end repaired
 //! ([`repaired`], or across the tracks: [`repaired_short`]).
 
-use crate::optim::constrained::Constrained;
 use crate::optim::sqp::sqp_into;
 use crate::optim::{BfgsConfig, Bounds};
 use crate::sim::TrackScore;
@@ -247,18 +246,20 @@ fn repaired_short<const N: usize, const K: usize>(
     if !obj.teeth() {
         return None;
     }
-    let mut z = *z;
-    for _ in 0..obj.count.min(K) {
+    let (mut z, rounds) = (*z, obj.count.min(K));
+    for round in 0..=rounds {
         let scores = obj.flight(&z).ok()?;
         let (_, v) = obj.value_of(&scores).ok()?;
         if v <= tol {
             return Some(z);
         }
+        if round == rounds {
+            break;
+        }
         let short = short_track(obj, &scores, false)?;
         z = lifted_across(obj, &z, bounds, short, tol)?;
     }
-    let (_, v) = obj.value(&z).ok()?;
-    (v <= tol).then_some(z)
+    None
 }
 
 /// The first track of the horizon flown with `scores` that falls short of

@@ -140,33 +140,45 @@ pub(super) fn bisect_steps<const K: usize, const N: usize>(
     keep: &mut impl FnMut(Point) -> bool,
 ) {
     let mut kept = false;
-    if let Some((mut inside, mut beyond)) = edge {
-        for _ in 0..EDGE {
-            let Some(p) = at_depth(obj, flown, 0.5 * (inside.0 + beyond.0), z) else {
-                break;
-            };
+    if let Some(step) = edge {
+        bisect(obj, (flown, z), step, |p| {
             kept |= keep(p);
-            if p.2 <= band {
-                inside = p;
-            } else {
-                beyond = p;
-            }
-        }
+            Some(p.2 <= band)
+        });
     }
-    let Some((mut on, mut off)) = cliff.filter(|_| !kept) else {
+    let Some(step) = cliff.filter(|_| !kept) else {
         return;
     };
-    for _ in 0..EDGE {
-        let Some(p) = at_depth(obj, flown, 0.5 * (on.0 + off.0), z) else {
-            return;
-        };
+    bisect(obj, (flown, z), step, |p| {
         if flat(p, plateau) {
-            on = p;
+            Some(true)
         } else if p.2 <= band {
             keep(p);
-            return;
+            None
         } else {
-            off = p;
+            Some(false)
+        }
+    });
+}
+
+/// `step` `(a, b)` bisected [`EDGE`] times, one flight of the tail each
+/// (as [`at_depth`]): `side` tells which end each midpoint replaces
+/// (`true`: `a`), or that the bisection stops there (`None`); so does a
+/// flight that fails.
+fn bisect<const K: usize, const N: usize>(
+    obj: &mut PlanObjective<'_, N>,
+    (flown, z): ((&[TrackScore; K], &VehicleState<N>, usize), &[f32; K]),
+    (mut a, mut b): Step,
+    mut side: impl FnMut(Point) -> Option<bool>,
+) {
+    for _ in 0..EDGE {
+        let Some(p) = at_depth(obj, flown, 0.5 * (a.0 + b.0), z) else {
+            return;
+        };
+        match side(p) {
+            Some(true) => a = p,
+            Some(false) => b = p,
+            None => return,
         }
     }
 }
@@ -187,23 +199,17 @@ fn off_dip(step: Step, plateau: (f32, f32), band: f32) -> Option<Step> {
 pub(super) fn bisect_dip<const K: usize, const N: usize>(
     obj: &mut PlanObjective<'_, N>,
     (flown, z): ((&[TrackScore; K], &VehicleState<N>, usize), &[f32; K]),
-    ((mut on, mut off), plateau): (Step, (f32, f32)),
+    (step, plateau): (Step, (f32, f32)),
     kept: impl Fn(Point) -> Option<(f32, f32)>,
 ) -> Option<((f32, f32), Point)> {
     let mut least: Option<((f32, f32), Point)> = None;
-    for _ in 0..EDGE {
-        let Some(p) = at_depth(obj, flown, 0.5 * (on.0 + off.0), z) else {
-            break;
-        };
-        match kept(p) {
-            Some(s) => {
-                least = least.filter(|l| !lex_less(s, l.0)).or(Some((s, p)));
-                on = p;
-            }
-            None if flat(p, plateau) => on = p,
-            None => off = p,
+    bisect(obj, (flown, z), step, |p| match kept(p) {
+        Some(s) => {
+            least = least.filter(|l| !lex_less(s, l.0)).or(Some((s, p)));
+            Some(true)
         }
-    }
+        None => Some(flat(p, plateau)),
+    });
     least
 }
 
