@@ -1198,6 +1198,23 @@ fn secant_rows_see_past_the_teeth() {
     horizon_within("secant_rows", 1.02, 9.121_193e6);
 }
 
+/// The secant rows once more after the last lift (`check_planner.py
+/// --seed 3175 --vehicle tools/reference/vehicles/rate.toml`,
+/// `unseen_3175_6`): the lift run again at the escapes' end took the
+/// line's `J` from 6.32e6 to 5.23e6 m³, its restart on tangent rows
+/// ending with track 1 at 240.3 m and track 2 held at its target. There
+/// track 2's least altitude rises 0.11 m per metre of `z_1` between the
+/// integrator's switches and falls 0.29 m/m across them: lifting track 1
+/// frees track 2 to dive, which track 3 pays back fivefold, and the
+/// tangent rows point the other way. The line's `J` was 5.205e6 m³,
+/// 1.0176× the f64 beam search's best safe plan (5.114 911e6 m³). The
+/// secant restart runs again after a lift that moved the end
+/// (`src/plan/wider.rs`): 1.0039×.
+#[test]
+fn the_secant_rows_follow_the_last_lift() {
+    horizon_within("secant_again", 1.008, 5.114_911e6);
+}
+
 /// The lift run again where the escapes took `J` 10 % below where it
 /// first ran (`make_lines.py`'s `unseen_5012_2`, the `integ` vehicle, seed
 /// 5012): the held edge took the horizon's `J` from 1.90e6 to 1.58e6 m³

@@ -124,9 +124,19 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// (`probe.rs`); then the wide beam where a track of that end is held
     /// far above its bottom or its first depth has no gradient, and where
     /// that restart is kept, the lift and the held edge again from it;
-    /// then the first depth's stride (`stride.rs`); last, where those took the horizon's `J`
-    /// below [`AGAIN`] of where the lift first ran, the lift and the held
-    /// edge once more (`lift/`' module docs). (The held track's restart
+    /// then the first depth's stride (`stride.rs`); then, where the depth
+    /// loop integrates, the SQP on secant rows (`restart.rs`,
+    /// `secant_restart`); last, where those took the horizon's `J` below
+    /// [`AGAIN`] of where the lift first ran, the lift and the held edge
+    /// once more (`lift/`' module docs), and where those moved the end,
+    /// the secant rows once more from it: on `check_planner.py --seed 3175
+    /// --vehicle tools/reference/vehicles/rate.toml` (`unseen_3175_6`) the
+    /// last lift's restart on tangent rows ended with a track held by the
+    /// depth before it, whose least altitude falls across the
+    /// integrator's switches as that depth deepens and rises between
+    /// them: the line 1.0176× the f64 search's best safe plan; after,
+    /// 1.0039×. On the 304 random lines two run it (+0.2 flights a line),
+    /// one moves (+0.008 %); the 18 shared runs keep their plans. (The held track's restart
     /// first ran before the lift, kept where it beat the SQP's end: on
     /// `check_planner.py --seed 2002 --vehicle
     /// tools/reference/vehicles/integ.toml`, `unseen_2002_0`, it took
@@ -189,7 +199,14 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // The lift and the held edge once more where the escapes took `J`
         // well below where they ran (module docs of `lift/`).
         if self.work.j < AGAIN * lifted_at {
-            return self.lift_then_held(obj, (h, bounds), tol, iterations);
+            let before = self.work.j;
+            let iterations = self.lift_then_held(obj, (h, bounds), tol, iterations);
+            // Where that moved the end, the secant restart once more from
+            // it (where the depth loop integrates: the module docs).
+            if self.work.j < before {
+                return self.secant_restart(obj, (h, bounds), tol, iterations);
+            }
+            return iterations;
         }
         iterations
     }
