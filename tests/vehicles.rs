@@ -1215,6 +1215,22 @@ fn the_secant_rows_follow_the_last_lift() {
     horizon_within("secant_again", 1.008, 5.114_911e6);
 }
 
+/// The secant restart's gradient of `J` from its own flights
+/// (`check_planner.py --seed 3171 --vehicle
+/// tools/reference/vehicles/twoki.toml`, `unseen_3171_3`): where the
+/// depth loop integrates `J` has teeth too. At the cold call's end track
+/// 2 flew at 586.7 m, 27 m above its reference altitude with `J_2` falling
+/// 7.5e3 m³ per metre deeper; the tangent pass read `∂J/∂z_2` = +3.7e3 m²
+/// (the slope between the integrator's switches) and the secant over 0.5
+/// m −9.9e3. The secant restart's rows saw the trend and its gradient did
+/// not: the line's `J` 6.170e6 m³, 1.0160× the f64 beam search's best safe
+/// plan (6.073 012e6 m³). The gradient is now the secant from the rows'
+/// flights (`src/plan/objective.rs`, `secant_rows`): 1.0009×.
+#[test]
+fn the_secant_restart_reads_the_trend_of_j() {
+    horizon_within("secant_gradient", 1.005, 6.073_012e6);
+}
+
 /// The lift run again where the escapes took `J` 10 % below where it
 /// first ran (`make_lines.py`'s `unseen_5012_2`, the `integ` vehicle, seed
 /// 5012): the held edge took the horizon's `J` from 1.90e6 to 1.58e6 m³

@@ -438,6 +438,8 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
             Err(err) => return Err(Stop::Sim(err)),
         };
         out.rows = rows;
+        out.j = e.j;
+        out.grad = e.grad_j;
         if self.secant {
             self.secant_rows(z, &e.scores, out)?;
         }
@@ -445,8 +447,6 @@ impl<const N: usize, const K: usize> Constrained<K> for PlanObjective<'_, N> {
         for (c, &t) in out.c.iter_mut().zip(out.group.iter()).take(rows) {
             *c -= self.target_of(usize::from(t));
         }
-        out.j = e.j;
-        out.grad = e.grad_j;
         out.infeasibility = self.infeasibility(&e.scores);
         out.band = self.band;
         self.last_violation = out.infeasibility;
@@ -480,9 +480,15 @@ impl<const N: usize> PlanObjective<'_, N> {
     /// slope between the integrator's switches, not the trend: on
     /// `unseen_2994_3` (`BENCHMARKS.md`, round 34) track 5's row read
     /// (−0.82, −0.006, 0, 0, −0.60) m/m where the f64 secants over
-    /// ±0.5 m read (−0.02, −0.96, 0, 0, −0.04). One plain flight a depth,
-    /// counted; not inlined: its frame stays off the tangent pass's
-    /// stack.
+    /// ±0.5 m read (−0.02, −0.96, 0, 0, −0.04). The gradient of `J` is
+    /// made the same flights' secant: `J` has teeth there too (on
+    /// `check_planner.py --seed 3171 --vehicle
+    /// tools/reference/vehicles/twoki.toml`, `unseen_3171_3`, the tangent
+    /// read `∂J/∂z_2` = +3.7e3 m² where the secant reads −9.9e3 and `J`
+    /// falls 7.5e3 m³ a metre over 20 m; with tangent gradient and secant
+    /// rows the restart stayed, the line 1.0160× the f64 search's best
+    /// safe plan; after, 1.0009×). One plain flight a depth, counted; not
+    /// inlined: its frame stays off the tangent pass's stack.
     #[inline(never)]
     fn secant_rows<const K: usize>(
         &mut self,
@@ -490,8 +496,13 @@ impl<const N: usize> PlanObjective<'_, N> {
         base: &[TrackScore; K],
         out: &mut Linearized<K>,
     ) -> Result<(), Stop> {
+        let base_j: f32 = base.iter().take(self.count).map(TrackScore::j).sum();
         for (j, &zj) in z.iter().enumerate().take(self.count) {
             let scores = self.flight(&with_depth(z, j, zj + SECANT_STEP))?;
+            let jt: f32 = scores.iter().take(self.count).map(TrackScore::j).sum();
+            if let Some(g) = out.grad.get_mut(j) {
+                *g = (jt - base_j) / SECANT_STEP;
+            }
             let rows = out.a.iter_mut().zip(out.group.iter()).take(out.rows);
             for (row, &g) in rows {
                 let g = usize::from(g);
