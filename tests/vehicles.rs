@@ -1231,6 +1231,21 @@ fn the_secant_restart_reads_the_trend_of_j() {
     horizon_within("secant_gradient", 1.005, 6.073_012e6);
 }
 
+/// A first track diving at the pitch limit the whole track
+/// (`check_planner.py --seed 3188 --vehicle
+/// tools/reference/vehicles/integ.toml`, `unseen_3188_1`): the cold SQP
+/// ended with track 1 at 482.7 m, where any depth from 470 m to 600 m
+/// flies the same (`∂J/∂z_1` exactly zero), track 2 held at its target and
+/// tracks 3 to 5 diving after it. The best safe plan takes track 1 to
+/// 674.7 m, near its own target, so that track 2 goes 7.5 m deeper: the
+/// line's `J` was 7.018e7 m³, 1.0515× the f64 beam search's best safe plan
+/// (6.674 504e7 m³). The first depth is now taken to its own boundary and
+/// the SQP restarted (`src/plan/dive.rs`, `dive_first`): 1.0004×.
+#[test]
+fn a_first_dive_on_its_plateau_is_taken_to_its_boundary() {
+    horizon_within("dive_first", 1.005, 6.674_504e7);
+}
+
 /// The lift run again where the escapes took `J` 10 % below where it
 /// first ran (`make_lines.py`'s `unseen_5012_2`, the `integ` vehicle, seed
 /// 5012): the held edge took the horizon's `J` from 1.90e6 to 1.58e6 m³

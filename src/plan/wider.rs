@@ -121,8 +121,10 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// declared uncertainty, the short end repaired (module docs), the
     /// lift (`lift/`) and the held edge (`jump/`, `held_last`); then the
     /// sink (`sink.rs`); then the probe of a held track whose dive ends
-    /// (`probe.rs`); then the wide beam where a track of that end is held
-    /// far above its bottom or its first depth has no gradient, and where
+    /// (`probe.rs`); then the dive begun earlier and the first track's
+    /// dive taken to its boundary (`dive.rs`); then the wide beam where a
+    /// track of that end is held far above its bottom or its first depth
+    /// has no gradient, and where
     /// that restart is kept, the lift and the held edge again from it;
     /// then the first depth's stride (`stride.rs`); then, where the depth
     /// loop integrates, the SQP on secant rows (`restart.rs`,
@@ -189,6 +191,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         iterations = self.sink_earlier(obj, (h, bounds), tol, iterations);
         iterations = self.probe_deeper(obj, (h, bounds), tol, iterations);
         iterations = self.dive_earlier(obj, (h, bounds), tol, iterations);
+        iterations = self.dive_first(obj, scan, (h, bounds), tol, iterations);
         let at = (tol, h_safe, iterations);
         let iterations = match self.wider_start((obj, fl, scan), (h, bounds, mu), at, true) {
             Some(it) => self.lift_then_held(obj, (h, bounds), tol, it),
