@@ -83,6 +83,22 @@ fn a_crawl_towards_a_jump_is_cut_short() {
     cut_short("crawl_jump", &[], 0, 68_944.8);
 }
 
+/// A crawl whose slivers alternate with short full steps
+/// (`check_planner.py --seed 3196 --vehicle
+/// tools/reference/vehicles/fast.toml`, `unseen_3196_2`, track 5,
+/// unconstrained): near 315 m BFGS's direction shrank to centimetres,
+/// and a sliver, a full step of 1.9 cm gaining 126 m³ (under ten
+/// thresholds), then a sliver again: the full step reset the count of
+/// slivers, and the run took 11 iterations, over the checker's 10. After a
+/// sliver, a step that gains under ten thresholds carries the crawl on
+/// now, however long (`optim/bfgs.rs`): 9 iterations. The f64 best from
+/// the same start: 3.53324e6 m³ (315.018 m).
+#[test]
+fn a_crawl_between_slivers_is_cut_short() {
+    let premise = [(0, 481.129), (1, 211.33), (2, 264.426), (3, 284.171)];
+    cut_short("crawl_between", &premise, 4, 3.533_24e6);
+}
+
 /// A polish ended on a tooth's top (`check_planner.py --seed 2792
 /// --vehicle tools/reference/vehicles/integ.toml`, `unseen_2792_1`, track
 /// 1, unconstrained): teeth 6 cm wide and 9 m³ high on a flat trend, where

@@ -54,7 +54,12 @@
 //!   an iteration, gaining 2e-5 of `J` each (11 iterations on
 //!   `check_planner.py --seed 2977
 //!   --vehicle tools/reference/vehicles/fast.toml`, `unseen_2977_2`
-//!   track 1; the polish then reads past the jump);
+//!   track 1; the polish then reads past the jump); and after a sliver, a
+//!   step of any length that gains less than that carries the crawl on
+//!   (where the direction itself has shrunk to centimetres, a full step
+//!   between two slivers had reset their count: 11 iterations on `--seed
+//!   3196 --vehicle tools/reference/vehicles/fast.toml`, `unseen_3196_2`
+//!   track 5, unconstrained; 9 now);
 //! - **vee**: with one free variable, after a line search that
 //!   backtracked, the step is capped where the tangent at the point meets
 //!   the secant through the last two rejected trials beyond it, the
@@ -304,7 +309,10 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             }
         }
         let dj = j - t.j;
-        let crawl = step < SHORT * along && dj <= CRAWL * cfg.tol.j_threshold(t.j);
+        let little = dj <= CRAWL * cfg.tol.j_threshold(t.j);
+        // (After a sliver, a step that gains little carries the crawl on,
+        // however long: module docs.)
+        let crawl = (step < SHORT * along || slivers > 0) && little;
         slivers = if step < SLIVER * along || crawl {
             slivers.saturating_add(1)
         } else {
