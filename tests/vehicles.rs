@@ -1262,6 +1262,21 @@ fn a_first_dive_on_its_plateau_is_taken_to_its_boundary() {
     horizon_within("dive_first", 1.005, 6.674_504e7);
 }
 
+/// A later track held on a tooth farther above its target
+/// (`check_planner.py --seed 3196 --vehicle
+/// tools/reference/vehicles/fast.toml`, `unseen_3196_0`, band 8 m): the
+/// cold SQP stopped with track 2 0.6 m above its target and `J` still
+/// falling 45e3 m³ a metre deeper, past the 5 % of the band within which
+/// a track counted as held where the depth loop integrates, so the lift
+/// never looked at it. The best safe plan climbs track 1 on its plateau
+/// so that track 2 flies 24 m deeper: the line's `J` was 1.677e7 m³,
+/// 1.113× the f64 beam search's best safe plan (1.506 348e7 m³). Held
+/// within 10 % now (`src/plan/objective.rs`, `TEETH_SLACK`): 1.0015×.
+#[test]
+fn a_track_held_on_a_tooth_above_its_target_is_lifted_for() {
+    horizon_within("held_teeth", 1.01, 1.506_348e7);
+}
+
 /// The lift run again where the escapes took `J` 10 % below where it
 /// first ran (`make_lines.py`'s `unseen_5012_2`, the `integ` vehicle, seed
 /// 5012): the held edge took the horizon's `J` from 1.90e6 to 1.58e6 m³

@@ -134,7 +134,7 @@
 //! deeper; the first depth's polish then took track 1 5 m deeper, which
 //! that shallow track 2 allowed, and the line was 1.113× the f64 search's
 //! best safe plan. So before the first depth, each later depth whose track
-//! clears its target by more than 5 % of the band (the lift's
+//! clears its target by more than 10 % of the band (5 % before round 40; the lift's
 //! [`TEETH_SLACK`](super::objective::TEETH_SLACK)), and whose
 //! gradient promises more than [`SHARE`] of `J` over [`STEP`], is
 //! polished the same way, the other depths held, against the same
