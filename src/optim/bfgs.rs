@@ -39,27 +39,10 @@
 //!   steps that grow only with the gradient (17 iterations of 0.3 to 2.8 m
 //!   on `check_planner.py --seed 1404 --vehicle
 //!   tools/reference/vehicles/second.toml`, `unseen_1404_5` track 2);
-//! - **slivers**: a step the line search had to cut below 1/64 of
-//!   the direction, twice in a row, ends the run
+//! - **slivers**: two steps in a row that the line search cut to a
+//!   sliver of the direction, or that crawl, end the run
 //!   ([`Status::LineSearchFailed`]): `J` is not smooth at the step's scale
-//!   (a depth loop that integrates conditionally makes it a sawtooth of
-//!   teeth centimetres wide, `plan/polish.rs`), every longer step lands
-//!   past a jump, and the run would crawl a few parts in 10⁵ of `J` an
-//!   iteration at the cost of a dozen halvings each; a step cut below a
-//!   quarter of the direction that gains less than ten times the 3.14b
-//!   threshold (a **crawl**) counts as a sliver too: where `J` jumps up
-//!   just ahead (not a kink, which the vee below caps), every first trial
-//!   lands past the jump at the smooth side's minimum, the interpolation
-//!   cuts it to a tenth, and the run closes on the jump a tenth of the way
-//!   an iteration, gaining 2e-5 of `J` each (11 iterations on
-//!   `check_planner.py --seed 2977
-//!   --vehicle tools/reference/vehicles/fast.toml`, `unseen_2977_2`
-//!   track 1; the polish then reads past the jump); and after a sliver, a
-//!   step of any length that gains less than that carries the crawl on
-//!   (where the direction itself has shrunk to centimetres, a full step
-//!   between two slivers had reset their count: 11 iterations on `--seed
-//!   3196 --vehicle tools/reference/vehicles/fast.toml`, `unseen_3196_2`
-//!   track 5, unconstrained; 9 now);
+//!   (`optim/sliver.rs`);
 //! - **vee**: with one free variable, after a line search that
 //!   backtracked, the step is capped where the tangent at the point meets
 //!   the secant through the last two rejected trials beyond it, the
@@ -68,6 +51,7 @@
 
 use nalgebra::SMatrix;
 
+use super::sliver::Slivers;
 use super::vee::Vee;
 use super::{
     Armijo, Bounds, LineSearch, Objective, OptimConfigError, OptimError, Outcome, Status,
@@ -76,18 +60,6 @@ use super::{
 
 /// Relative tolerance of the curvature guard (see the module docs).
 const CURVATURE_TOL: f32 = 1e-6;
-
-/// A step shorter than this share of the direction is a sliver (module
-/// docs): six halvings of the line search.
-const SLIVER: f32 = 1.0 / 64.0;
-
-/// A step shorter than this share of the direction that gains less than
-/// [`CRAWL`] stopping thresholds is a crawl, counted as a sliver (module
-/// docs).
-const SHORT: f32 = 0.25;
-
-/// How many 3.14b thresholds a short step must gain not to be a crawl.
-const CRAWL: f32 = 10.0;
 
 /// A step at least this share of the direction is the full step (the box
 /// may clip it by rounding).
@@ -242,7 +214,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
     let mut rescaled = informed;
     let mut skipped_updates = 0_u32;
     let mut iterations = 0_u32;
-    let mut slivers = 0_u32;
+    let mut slivers = Slivers::default();
     let mut vee = Vee::default();
 
     let status = loop {
@@ -309,15 +281,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
             }
         }
         let dj = j - t.j;
-        let little = dj <= CRAWL * cfg.tol.j_threshold(t.j);
-        // (After a sliver, a step that gains little carries the crawl on,
-        // however long: module docs.)
-        let crawl = (step < SHORT * along || slivers > 0) && little;
-        slivers = if step < SLIVER * along || crawl {
-            slivers.saturating_add(1)
-        } else {
-            0
-        };
+        slivers.record((step, along), (dj, cfg.tol.j_threshold(t.j)));
         z = t.z;
         j = t.j;
         g = t.g;
@@ -335,7 +299,7 @@ pub(crate) fn bfgs_into<const K: usize, O: Objective<K>, L: LineSearch<K>>(
         if libm::fabsf(dj) <= cfg.tol.j_threshold(j) {
             break Status::Converged;
         }
-        if slivers >= 2 {
+        if slivers.end() {
             break Status::LineSearchFailed;
         }
     };

@@ -20,6 +20,7 @@ mod dual;
 pub mod gd;
 pub(crate) mod qp;
 pub(crate) mod root;
+mod sliver;
 pub(crate) mod sqp;
 pub(crate) mod step;
 pub(crate) mod vee;

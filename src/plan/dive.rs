@@ -204,11 +204,11 @@ fn bracket(scan: &ScanLog, z1: f32, target: f32) -> Option<(f32, f32)> {
         .iter()
         .filter(|&(z, least)| z >= z1 && least >= target)
         .map(|(z, _)| z)
-        .fold(None, |m: Option<f32>, z| Some(m.map_or(z, |m| m.max(z))))?;
+        .reduce(f32::max)?;
     let out = scan
         .iter()
         .filter(|&(z, least)| z > safe && least < target)
         .map(|(z, _)| z)
-        .fold(None, |m: Option<f32>, z| Some(m.map_or(z, |m| m.min(z))))?;
+        .reduce(f32::min)?;
     Some((safe, out))
 }

@@ -490,7 +490,8 @@ impl<const N: usize> PlanObjective<'_, N> {
     /// `unseen_2994_3` (`BENCHMARKS.md`, round 34) track 5's row read
     /// (−0.82, −0.006, 0, 0, −0.60) m/m where the f64 secants over
     /// ±0.5 m read (−0.02, −0.96, 0, 0, −0.04). The gradient of `J` is
-    /// made the same flights' secant: `J` has teeth there too (on
+    /// made the same flights' secant against `out.j` (the tangent pass's
+    /// `J` at `z`, the sum of `base`'s): `J` has teeth there too (on
     /// `check_planner.py --seed 3171 --vehicle
     /// tools/reference/vehicles/twoki.toml`, `unseen_3171_3`, the tangent
     /// read `∂J/∂z_2` = +3.7e3 m² where the secant reads −9.9e3 and `J`
@@ -505,12 +506,11 @@ impl<const N: usize> PlanObjective<'_, N> {
         base: &[TrackScore; K],
         out: &mut Linearized<K>,
     ) -> Result<(), Stop> {
-        let base_j: f32 = base.iter().take(self.count).map(TrackScore::j).sum();
         for (j, &zj) in z.iter().enumerate().take(self.count) {
             let scores = self.flight(&with_depth(z, j, zj + SECANT_STEP))?;
             let jt: f32 = scores.iter().take(self.count).map(TrackScore::j).sum();
             if let Some(g) = out.grad.get_mut(j) {
-                *g = (jt - base_j) / SECANT_STEP;
+                *g = (jt - out.j) / SECANT_STEP;
             }
             let rows = out.a.iter_mut().zip(out.group.iter()).take(out.rows);
             for (row, &g) in rows {
