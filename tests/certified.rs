@@ -495,6 +495,68 @@ fn the_certificate_bounds_every_current_between_its_samples() {
     assert_eq!(checked, 2 * 161 * 5);
 }
 
+/// The flight-path offset declared alone (`check_certified.py --seed 3218
+/// --bounds-kind motion`, `synthetic_098`, fixture `offset_kink`, a
+/// second-order plant): the `plan` tool's horizon line. Track 6's least
+/// altitude against `α` is the lower of two branches, one falling to
+/// 55.10 m at −0.62° and one rising from there: a kink between the levels
+/// −0.92° and −0.46° (about 56 m each), under the certificate of the
+/// sampled levels less the vehicle margin (55.52 m). The floors between a
+/// line's levels (`certify/valley.rs`) bound it. Each track's certified
+/// altitude is at most its least altitude in 185 worlds across the
+/// declared offset.
+#[test]
+fn the_certificate_bounds_a_kink_between_its_offsets() {
+    let mut cfg = VehicleConfig {
+        speed: 0.8409,
+        sample_time: 0.248,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 29.91;
+    cfg.autopilot.depth_pid = PidGains {
+        kp: 1.356,
+        ki: 0.02944,
+        kd: 1.867,
+    };
+    cfg.autopilot.pitch_pid = PidGains {
+        kp: 1.451,
+        ki: 0.1041,
+        kd: 2.88,
+    };
+    let plant = TransferFunction::<3>::pitch(&[-0.62], &[1.0, 1.45, 0.29]).unwrap();
+    let vehicle = Vehicle::new(&cfg, plant).unwrap();
+    let alpha_max = 1.84;
+    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
+    let (x, b, map, wps) = fixture_line("offset_kink");
+    let (h_r, h_a) = (66.67, 45.6);
+    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
+    let bottom = Profile::<8192>::new(&x, &b).unwrap();
+    let plan = tool::json_of_fixture("offset_kink", &[]);
+    let tracks = plan["tracks"].as_array().unwrap();
+    let value = |k: &str| -> Vec<f32> {
+        tracks
+            .iter()
+            .map(|t| t[k].as_f64().unwrap() as f32)
+            .collect()
+    };
+    let (depths, certified) = (value("depth"), value("certified_min_altitude"));
+    let checked = with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
+        let start = sc.start_state(d0);
+        let mut checked = 0;
+        for k in 0..=184 {
+            let world = World {
+                speed: vehicle.speed(),
+                flight_path_offset: alpha_max * (k as f32 / 92.0 - 1.0),
+                vertical_current: 0.0,
+            };
+            let plan = (&depths[..], &certified[..]);
+            checked += certified_bounds(sc, (&world, &bottom), &start, plan, "horizon");
+        }
+        checked
+    });
+    assert_eq!(checked, 185 * 6);
+}
+
 /// With nothing declared, every track's `certified_min_altitude` is its
 /// `min_altitude` (spec/cli.md), after a predicted collision too
 /// (`check_certified.py --seed 2567 --bounds-kind motion`,

@@ -45,7 +45,7 @@
 //! What no move can avoid, the certificates fly both ways: with one
 //! vehicle world (nothing declared, or only the map), a certificate flies
 //! the rest of the line from the other switch's state too wherever a track
-//! ends on the edge (`certify/mod.rs`), and a committed depth that ends on
+//! ends on the edge (`certify/flight.rs`), and a committed depth that ends on
 //! it leaves that state in the tube as a branch, flown by every later
 //! certificate ([`Planner::branch_off_the_edge`]).
 //!
@@ -115,7 +115,7 @@ const J_SHARE: f32 = 1e-3;
 /// a knife edge's other switch is flown as a world of its own. Under
 /// declared motion (speed, path offset, current) each world switches at
 /// its own sample, and the vehicle margin's floor of a sample's climb
-/// covers the switch (`certify/mod.rs`).
+/// covers the switch (`certify/mod.rs`, `flight.rs`).
 pub(super) fn one_vehicle<const N: usize>(sc: &Scenario<'_, N>) -> bool {
     !sc.mission().uncertainty().motion_uncertain()
 }
@@ -166,19 +166,26 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             if let Some(first) = self.work.z.first_mut() {
                 *first = f.depth;
             }
+            // The later tracks' gaps were screened from the depth on the
+            // edge: the next calls screen their own.
+            let later = self
+                .gaps
+                .get_mut(track.saturating_add(1)..)
+                .unwrap_or(&mut []);
+            later.iter_mut().for_each(|g| *g = 0.0);
         }
     }
 
     /// With one vehicle world ([`one_vehicle`]), where the committed
     /// flight ends on its waypoint's knife edge, the tube's branch from
     /// the other switch's state (`Tube::branch`): the committed depth's
-    /// certificate flew it already (`certify/mod.rs`), and every later
+    /// certificate flew it already (`certify/flight.rs`), and every later
     /// call's certificates fly it too, so that the line stays certified
     /// however the vehicle's arithmetic switches there. A budgeted call
     /// carries no branch: every later call would fly it, and its least
     /// budget would be a flight more (a budgeted call's certificates still
     /// fly an edge's other switch when their flights allow,
-    /// `certify/mod.rs`).
+    /// `certify/flight.rs`).
     #[inline(never)]
     pub(super) fn branch_off_the_edge(
         &mut self,

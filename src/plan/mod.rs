@@ -127,7 +127,7 @@
 //! | `carry.rs` | a track flown at a depth the planner did not choose: the worlds carried through it |
 //! | `search.rs` | the continuation search from a certified anchor (§11) |
 //! | `gaps.rs` | the SQP's targets raised by the certification gap (§12) |
-//! | `certify/` | certificates over the declared worlds (§12), [`certify_line`]; the worlds' states between calls (`states.rs`) |
+//! | `certify/` | certificates over the declared worlds (§12), [`certify_line`]; one world's flight (`flight.rs`); the floors between a line of worlds' levels (`valley.rs`); the worlds' states between calls (`states.rs`) |
 //! | `flights.rs` | the call's plain flights, counted |
 //! | `solve.rs` | the optimizer runs: the SQP (BFGS), penalty stages (GD), plateau escape |
 //! | `scan.rs` | the search box and the coarse scan (the starting point) |

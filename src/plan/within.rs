@@ -305,7 +305,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 /// over the map): the first track's flight and the certificate it is when
 /// the nominal world over the map is the only one. Where a track ends on
 /// its waypoint's knife edge, the line is flown again as a certificate's
-/// world is, each edge's switch the other way too (`certify/mod.rs`),
+/// world is, each edge's switch the other way too (`certify/flight.rs`),
 /// while `count` leaves room below `cap` (else the nominal switch alone,
 /// the contract's certificate).
 #[inline(never)]
@@ -340,8 +340,7 @@ fn fly_line<const N: usize>(
                     branched = true;
                     let (w, bottom) = (World::nominal(sc.vehicle()), sc.profile());
                     let at = (state, track);
-                    let (_, a) =
-                        fly_world(sc, &w, bottom, at, depths, (0.0, &mut []), (count, cap));
+                    let (_, a) = fly_world(sc, &w, bottom, at, depths, (0.0, &[]), (count, cap));
                     all = all.min(a);
                 }
                 st = next;

@@ -62,7 +62,11 @@ impl World {
     /// at `w` = 0.0555 m/s, between the levels 0.0371 and 0.0742, 0.15 m
     /// below the reported certified altitude (the sampled worlds' less the
     /// vehicle margin), and `--seed 2547` one near 0.02 m/s 1.8 m below;
-    /// the finer levels catch both. Where the flight
+    /// the finer levels catch both; a kink between two levels, the
+    /// certificate bounds from its neighbours (`plan/certify/valley.rs`:
+    /// the worlds of one speed and one level of `α` make a line along
+    /// `w`, and with `α` declared alone those of one speed a line along
+    /// `α`). Where the flight
     /// responds linearly to `α` and `w` (inside the autopilot's limits) the
     /// corners alone bound it; the interior levels catch the saturated
     /// stretches where it does not (a smaller current can then leave the

@@ -39,6 +39,12 @@
 //! 40 mm under the corners with `α_max` = 0.065° and nothing else
 //! declared, where the 15 s margin was 27 mm and one sample's climb
 //! 72 mm). Above that floor the 15 s margin is taken to cover both.
+//!
+//! Where a track's least altitude has a kink between two levels of one
+//! bound (its lowest point moves from one place of the track to another),
+//! the margin need not cover it (0.42 m short, `valley.rs`): along each
+//! line of levels, the crossing of the chords outside an interval bounds
+//! the interval's floor, and lowers the certificate with the flights.
 
 use core::cell::Cell;
 
@@ -46,9 +52,14 @@ use heapless::Vec;
 
 use crate::model::{ProfileView, Uncertainty, Vehicle};
 use crate::num::DEG;
-use crate::sim::{MAX_WORLDS, Scenario, SimError, TrackScore, VehicleState, World};
+use crate::sim::{MAX_WORLDS, Scenario, SimError, VehicleState, World};
 
+mod flight;
 mod states;
+mod valley;
+
+pub(in crate::plan) use flight::fly_world;
+use valley::{LineRows, Lines};
 
 /// A set of worlds, bit `i % 32` of word `i / 32` for world `i` (words,
 /// not a `u128`, so that the planner keeps the alignment of its `f32`s
@@ -132,6 +143,8 @@ pub(super) struct Tube<const N: usize> {
     minima_of: Cell<u32>,
     /// The last certificate id given.
     ids: Cell<u32>,
+    /// The line being certified (`valley.rs`).
+    rows: LineRows,
 }
 
 impl<const N: usize> Default for Tube<N> {
@@ -151,6 +164,7 @@ impl<const N: usize> Default for Tube<N> {
             minima: Cell::new([f32::NEG_INFINITY; MAX_TRACKS]),
             minima_of: Cell::new(0),
             ids: Cell::new(0),
+            rows: LineRows::default(),
         }
     }
 }
@@ -232,7 +246,7 @@ impl<const N: usize> Tube<N> {
     ) -> Certificate {
         let n = self.worlds.len();
         let start = self.worst.get().min(n.saturating_sub(1));
-        let order = (start..n).chain(0..start);
+        let order = core::iter::once(start).chain((0..n).filter(move |&i| i != start));
         let mut per_track = [f32::INFINITY; MAX_TRACKS];
         let at = (floor, flights, &mut per_track);
         let (c, worst) = self.fly_worlds(sc, bottom, depths, order, at);
@@ -243,11 +257,13 @@ impl<const N: usize> Tube<N> {
         c
     }
 
-    /// Flies `depths` in the worlds `order` names (indices), each from its
-    /// state, into one certificate (less the margin), with the world that
-    /// set its least altitude; `partial` when it stopped with worlds left
-    /// because that altitude fell below `floor` (m). A certificate of
-    /// every world keeps its per-track altitudes ([`Tube::minima_of`]).
+    /// Flies `depths` in the worlds `order` names (indices; ascending but
+    /// for the first), each from its state, into one certificate (less
+    /// the margin), with the world that set its least altitude; `partial`
+    /// when it stopped with worlds left because that altitude fell below
+    /// `floor` (m). The floors between a line's levels ([`Valley`]) lower
+    /// it too. A certificate of every world keeps its per-track altitudes
+    /// ([`Tube::minima_of`]).
     fn fly_worlds(
         &self,
         sc: &Scenario<'_, N>,
@@ -263,6 +279,8 @@ impl<const N: usize> Tube<N> {
             id: 0,
         };
         *per_track = [f32::INFINITY; MAX_TRACKS];
+        let mut lines = Lines::new(&self.rows, &self.worlds, self.branches);
+        let tracks = depths.len();
         let mut flown = 0_usize;
         let mut worst = None;
         let mut order = order.peekable();
@@ -271,11 +289,28 @@ impl<const N: usize> Tube<N> {
                 continue;
             };
             let at = (st, self.at());
-            let minima = (self.margin, &mut per_track[..]);
+            let (row, floors) = lines.slot(i, &self.worlds, (tracks, &mut *per_track));
+            c.first = c.first.min(floors.0);
+            c.all = c.all.min(floors.1);
             // (Room for every world's flight after a branch.)
             let worlds = u32::try_from(self.worlds.len()).unwrap_or(u32::MAX);
             let cap = self.branch_cap.saturating_sub(worlds);
-            let (first, all) = fly_world(sc, w, bottom, at, depths, minima, (flights, cap));
+            let own = row.unwrap_or_else(|| Cell::from_mut(&mut per_track[..]).as_slice_of_cells());
+            let (first, all) = fly_world(
+                sc,
+                w,
+                bottom,
+                at,
+                depths,
+                (self.margin, own),
+                (flights, cap),
+            );
+            if let Some(row) = row {
+                per_track
+                    .iter_mut()
+                    .zip(row)
+                    .for_each(|(p, h)| *p = p.min(h.get()));
+            }
             flown = flown.saturating_add(1);
             c.first = c.first.min(first - self.margin);
             if all - self.margin < c.all {
@@ -287,6 +322,9 @@ impl<const N: usize> Tube<N> {
                 break;
             }
         }
+        let floors = lines.finish(&self.worlds, (tracks, &mut *per_track));
+        c.first = c.first.min(floors.0);
+        c.all = c.all.min(floors.1);
         if !c.partial && flown == self.worlds.len() {
             let id = self.ids.get().wrapping_add(1).max(1);
             self.ids.set(id);
@@ -369,135 +407,13 @@ impl<const N: usize> Tube<N> {
     }
 }
 
-/// One world's flight of `depths` from `st` on `track`: the least altitude
-/// on the first track, and to the end (`-inf` from the track on which a
-/// flight fails). Each track's altitude less `margin` also lowers the
-/// matching entry of `per_track` (which may be shorter, or empty).
-///
-/// With one vehicle world (nothing declared, or only the map: each world
-/// then switches where the nominal flight does), where a track's end
-/// lies on its waypoint's knife edge ([`Scenario::on_edge`]), the line is
-/// also flown with that switch the other way ([`fly_once`]'s branch, one
-/// flight more each) while `flights` is below `cap` (else the nominal
-/// switch alone), and both flights count: the same depths flown in other
-/// arithmetic may switch the other way, and the next track's least
-/// altitude can move by a tenth of a metre (`check_planner.py --seed
-/// 2585`, `unseen_2585_5`: 60.09 m in f32, 59.974 m in f64, below `h_a`).
-/// Under declared motion the vehicle margin's floor covers it instead.
-/// (Not inlined: its callers share one copy of the flight. A branch flies
-/// from the world's start again, after the first flight rather than
-/// inside it, so that a certificate's stack holds one flight at a time.)
-#[allow(clippy::too_many_arguments)]
-#[inline(never)]
-pub(super) fn fly_world<const N: usize>(
-    sc: &Scenario<'_, N>,
-    w: &World,
-    bottom: ProfileView<'_>,
-    at: (&VehicleState<N>, usize),
-    depths: &[f32],
-    (margin, per_track): (f32, &mut [f32]),
-    (flights, cap): (&mut u32, u32),
-) -> (f32, f32) {
-    const FAILED: (f32, f32) = (f32::NEG_INFINITY, f32::NEG_INFINITY);
-    let world = (w, bottom);
-    *flights = flights.saturating_add(1);
-    let Ok((first, mut all, edges)) =
-        fly_once(sc, world, at, depths, (margin, &mut *per_track), None)
-    else {
-        return FAILED;
-    };
-    let edges = if !sc.mission().uncertainty().motion_uncertain() {
-        edges
-    } else {
-        0
-    };
-    for j in (0..depths.len().min(64)).filter(|&j| (edges >> j) & 1 == 1) {
-        if *flights >= cap {
-            break;
-        }
-        *flights = flights.saturating_add(1);
-        let minima = (margin, &mut *per_track);
-        all = match fly_once(sc, world, at, depths, minima, Some(j)) {
-            Ok((_, a, _)) => all.min(a),
-            Err(_) => f32::NEG_INFINITY,
-        };
-    }
-    (first, all)
-}
-
-/// One flight of the line `depths` from `st` on `track` in world `w` over
-/// `bottom`: the least altitude on the first track, and to the end
-/// (`-inf` from the track on which a flight fails), each track's less
-/// `margin` also lowering its entry of `per_track`; with the tracks whose
-/// end lies on a knife edge, a track of `depths` following (bit `j` for
-/// track `track + j`, the first 64). With `branch` `Some(j)`, the switch
-/// at the end of track `j` (of `depths`) falls the other way
-/// ([`Scenario::switch_other_way`]; its own edges are not reported).
-///
-/// # Errors
-/// [`SimError`] for a waypoint outside `bottom`.
-#[inline(always)]
-fn fly_once<const N: usize>(
-    sc: &Scenario<'_, N>,
-    (w, bottom): (&World, ProfileView<'_>),
-    (st, track): (&VehicleState<N>, usize),
-    depths: &[f32],
-    (margin, per_track): (f32, &mut [f32]),
-    branch: Option<usize>,
-) -> Result<(f32, f32, u64), SimError> {
-    let scw = sc.in_world(w, bottom)?;
-    let mut score = [TrackScore::default()];
-    let mut state = *st;
-    let (mut first, mut all, mut edges) = (f32::INFINITY, f32::INFINITY, 0_u64);
-    // One flight of the line, flown track by track (runs chain exactly).
-    for (j, &z) in depths.iter().enumerate() {
-        let t = track.saturating_add(j);
-        let flown = scw.fly(&state, t, &[z], &mut score);
-        let h = match (&flown, score.first()) {
-            (Ok(_), Some(s)) => s.min_altitude(),
-            _ => f32::NEG_INFINITY,
-        };
-        all = all.min(h);
-        if j == 0 {
-            first = h;
-        }
-        if let Some(l) = per_track.get_mut(j) {
-            *l = l.min(h - margin);
-        }
-        let Ok(mut next) = flown else {
-            break;
-        };
-        if branch == Some(j) {
-            // (Track `j`'s own flight is the first one's, but for a
-            // sample past its waypoint, which the next track scores.)
-            // (`state` is used up: `next` follows.)
-            if scw
-                .switch_other_way((&mut state, &mut next), (t, z), &mut score)
-                .is_err()
-            {
-                all = f32::NEG_INFINITY;
-                let later = per_track.get_mut(j.saturating_add(1)..).unwrap_or(&mut []);
-                later.iter_mut().for_each(|l| *l = f32::NEG_INFINITY);
-                break;
-            }
-        } else if branch.is_none()
-            && j < 64
-            && j.saturating_add(1) < depths.len()
-            && scw.on_edge(t, &next)
-        {
-            edges |= 1 << j;
-        }
-        state = next;
-    }
-    Ok((first, all, edges))
-}
-
 /// Certifies a fixed line (model contract §12): `depths` (one per track
 /// from `first`) flown open loop from `start` in every declared world over
 /// `bottom` (the certification bottom, or the map when the map is exact).
-/// Writes each track's least altitude over the worlds, less the vehicle
-/// margin (module docs), into `least` (m; `-inf` where a world's flight
-/// fails).
+/// Writes each track's least altitude over the worlds and the floors
+/// between a line's levels (`valley.rs`, the first [`MAX_TRACKS`] tracks),
+/// less the vehicle margin (module docs), into `least` (m; `-inf` where a
+/// world's flight fails).
 ///
 /// # Errors
 /// [`SimError`] for bad arguments (`least` shorter than `depths`, tracks
@@ -516,17 +432,36 @@ pub fn certify_line<const N: usize>(
     let u = sc.mission().uncertainty();
     let margin = vehicle_margin(sc.vehicle(), u);
     let mut flights = 0;
-    for w in World::corners(sc.vehicle(), u) {
+    let worlds = World::corners(sc.vehicle(), u);
+    let keep = LineRows::default();
+    let mut lines = Lines::new(&keep, &worlds, 0);
+    let mut per_track = [f32::INFINITY; MAX_TRACKS];
+    let all = Cell::from_mut(&mut *least).as_slice_of_cells();
+    for (i, w) in worlds.iter().enumerate() {
         let at = (start, first);
-        fly_world(
-            sc,
-            &w,
-            bottom,
-            at,
-            depths,
-            (margin, &mut *least),
-            (&mut flights, u32::MAX),
-        );
+        let (row, _) = lines.slot(i, &worlds, (depths.len(), &mut per_track));
+        let count = (&mut flights, u32::MAX);
+        match row {
+            Some(row) => {
+                fly_world(sc, w, bottom, at, depths, (margin, row), count);
+                per_track
+                    .iter_mut()
+                    .zip(row)
+                    .for_each(|(p, h)| *p = p.min(h.get()));
+                if depths.len() > MAX_TRACKS {
+                    // (The tracks past the rows' reach, flown again.)
+                    let count = (&mut flights, u32::MAX);
+                    fly_world(sc, w, bottom, at, depths, (margin, all), count);
+                }
+            }
+            None => {
+                fly_world(sc, w, bottom, at, depths, (margin, all), count);
+            }
+        }
+    }
+    lines.finish(&worlds, (depths.len(), &mut per_track));
+    for (l, &p) in all.iter().zip(&per_track) {
+        l.set(l.get().min(p));
     }
     Ok(())
 }

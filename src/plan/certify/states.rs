@@ -240,6 +240,7 @@ fn fly_on<const N: usize>(
 mod tests {
     use super::super::*;
     use crate::model::{Mission, Profile, Uncertainty, Vehicle, Waypoints};
+    use crate::sim::TrackScore;
 
     /// The lazy advance flies the same states as the eager one, world by
     /// world (the screening worlds first, then the rest), and a complete
