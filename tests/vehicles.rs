@@ -1475,3 +1475,20 @@ fn a_plateau_dip_short_within_the_band_is_bisected() {
 fn a_short_end_held_across_the_tracks_is_repaired() {
     horizon_within("short_across", 1.01, 7.836_746e6);
 }
+
+/// A gap kept from a depth that was moved (`check_planner.py --seed 3223
+/// --vehicle tools/reference/vehicles/slow.toml`, `unseen_3223_2`): the
+/// calls before the last screened track 5's certification gap (`gaps.rs`)
+/// from a horizon whose track 4 ended 0.1 mm from waypoint 4, where the
+/// screen's flight switched a sample from the SQP's and read track 5's
+/// least altitude 8.4 cm lower. Track 4's call then moved its depth 1.5 cm
+/// off that knife edge (`knife.rs`), but the gap stayed, raised the last
+/// call's target to 60.086 m, above the 60.021 m plateau on which track 5
+/// may dive 50 m deeper, and the line's `J` was 2.678e6 m³, 2.06× the f64
+/// beam search's best safe plan (1.298 882e6 m³). A move off the edge now
+/// drops the later tracks' gaps, and the next calls screen their own:
+/// 1.0011×.
+#[test]
+fn a_gap_screened_on_a_knife_edge_goes_with_the_move_off_it() {
+    horizon_within("stale_gap", 1.005, 1.298_882e6);
+}

@@ -63,6 +63,15 @@
 //! its own flight, `constrained`, `J` 1.0041× the f64 best from one
 //! switch's state.
 //!
+//! A move drops the later tracks' certification gaps (`gaps.rs`): they
+//! were screened from the depth on the edge, whose other switch can set a
+//! later track's least altitude centimetres apart, and the last call of
+//! a line aims at its kept gap without screening again
+//! (`check_planner.py --seed 3223 --vehicle
+//! tools/reference/vehicles/slow.toml`, `unseen_3223_2`: a gap of 8.4 cm
+//! kept from the edge lifted the last track's target above a plateau 2 cm
+//! over `h_a`, 50 m short of the best plan's depth).
+//!
 //! In horizon mode, constrained, a call may commit the previous call's
 //! continuation instead of its candidate (`commit.rs`): where that
 //! continuation's first depth is on the edge and the candidate is not,
