@@ -110,10 +110,11 @@ pub(super) struct LineRows {
 }
 
 impl Default for LineRows {
+    /// Zeros (a memset): every row is emptied before a flight writes it.
     fn default() -> Self {
         Self {
-            rows: Cell::new([[f32::INFINITY; MAX_TRACKS]; LINE]),
-            held: Cell::new([f32::INFINITY; MAX_TRACKS]),
+            rows: Cell::new([[0.0; MAX_TRACKS]; LINE]),
+            held: Cell::new([0.0; MAX_TRACKS]),
         }
     }
 }
