@@ -20,14 +20,16 @@
 //! branches are straight that is the kink's floor exactly (on
 //! `synthetic_098`: 54.4 m); where they curve upward (a smooth valley) it
 //! lies below it. A track's certified altitude is the least of its
-//! flights' and these floors. The two intervals at a line's ends, which
-//! have a level on one side only, are not bounded this way; nor are the
-//! lines along a second declared bound or along the speed (the vehicle
-//! margin is left for those).
+//! flights' and these floors. The two intervals at a line's ends have a
+//! level on one side only; with straight branches they hold no dip (the
+//! corner's level is set by the branch through it, the other branch lies
+//! above it there, so the lower of the two stays above both ends), and
+//! they get no floor. Nor do the lines along a second declared bound or
+//! along the speed: the vehicle margin is left for those.
 //!
 //! A line's flights are kept until its last one ([`LineRows`], in the
-//! [`super::Tube`]: nine tracks' rows of a line of nine levels take 2.3
-//! KiB, which the certificate's stack could not hold); a certificate
+//! [`super::Tube`]: nine rows of 64 tracks, 2.3 KiB, which the
+//! certificate's stack could not hold); a certificate
 //! flies the world that was worst last time first, and that world's
 //! altitudes are held until its line comes.
 
