@@ -233,7 +233,8 @@ impl<const N: usize> Tube<N> {
 
     /// Flies `depths` (the tube's track first, one depth per track) in
     /// every world over `bottom` from its state; counts the flights. The
-    /// world that was worst last time flies first; once a world's least
+    /// world that was worst last time flies first, the rest in index
+    /// order (a line's worlds in a row, `valley.rs`); once a world's least
     /// altitude (less the margin) is below `floor` (m) the rest are left
     /// unflown and the certificate is `partial` (`f32::NEG_INFINITY`: fly
     /// them all).
@@ -261,8 +262,9 @@ impl<const N: usize> Tube<N> {
     /// for the first), each from its state, into one certificate (less
     /// the margin), with the world that set its least altitude; `partial`
     /// when it stopped with worlds left because that altitude fell below
-    /// `floor` (m). The floors between a line's levels ([`Valley`]) lower
-    /// it too. A certificate of every world keeps its per-track altitudes
+    /// `floor` (m). The floors between a line's levels (`valley.rs`: a
+    /// line's worlds flown in a row, hence the ascending order) lower it
+    /// too. A certificate of every world keeps its per-track altitudes
     /// ([`Tube::minima_of`]).
     fn fly_worlds(
         &self,
