@@ -1492,3 +1492,23 @@ fn a_short_end_held_across_the_tracks_is_repaired() {
 fn a_gap_screened_on_a_knife_edge_goes_with_the_move_off_it() {
     horizon_within("stale_gap", 1.005, 1.298_882e6);
 }
+
+/// A stride whose restart left the later depths on plateaus
+/// (`check_planner.py --seed 3249 --vehicle
+/// tools/reference/vehicles/heavy.toml`, `unseen_3249_2`): the cold SQP
+/// ended with track 1 at 660.3 m, where track 2's least altitude (set by
+/// the arrival) dips 4 cm under its target for the next 19 m of `z_1`
+/// and clears it again to 709 m, with `J` falling 63e3 m³ a metre
+/// deeper. The stride's promise (`∂J/∂z_1` over the band, 1.25e6 m³)
+/// was under its 10 % of the horizon's `J` (1.33e6), so it never ran;
+/// at 5 % it runs, and its SQP from 680.3 m found track 1 at 708.6 m
+/// and track 2 at 831.8 m, the best plan's, but its first step had put
+/// tracks 3 and 4 on plateaus (dives at the pitch limit the whole track,
+/// `∂J/∂z` exactly zero) 8.6e6 m³ worse, and it went back to its start.
+/// Its end with those depths back at the start, restarted: the line's
+/// `J` was 1.301× the f64 beam search's best safe plan (8.309 82e6 m³),
+/// now 1.0014×.
+#[test]
+fn a_stride_s_restart_leaves_no_depth_on_a_plateau() {
+    horizon_within("stride_plateaus", 1.01, 8.309_82e6);
+}

@@ -256,7 +256,7 @@ mod tests {
             &mut out,
         )
         .unwrap();
-        (out, end.left.is_some())
+        (out, end.left.is_some() && end.lower)
     }
 
     #[test]

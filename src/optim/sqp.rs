@@ -170,25 +170,19 @@ pub(crate) fn sqp_into<const K: usize, O: Constrained<K>>(
             break Status::MaxIterations;
         }
     };
-    let (left, left_j) = (run.z, run.lin.j);
+    let (left, left_j, left_grad) = (run.z, run.lin.j, run.lin.grad);
     let returned = best.return_to(obj, (&mut run.z, &mut run.lin), (feas_tol, &cfg.tol));
     run.evaluations = run.evaluations.saturating_add(u32::from(returned));
-    let z = Vector::from(run.z);
-    out.z = run.z;
-    out.j = run.lin.j;
-    out.gradient = run.lin.grad;
-    out.grad_norm = bounds.free_gradient_norm_v(&z, &Vector::from(run.lin.grad));
-    out.status = status;
-    out.iterations = run.iterations;
-    out.evaluations = run.evaluations;
-    out.skipped_updates = run.skipped;
+    run.report(out, bounds, status);
     Ok(SqpEnd {
         rho: run.rho,
         kink: run.lin.kinked(kink_band(&run.lin, feas_tol), n),
         blended: run.lin.blended(kink_band(&run.lin, feas_tol), n),
         returned,
         // (Given up: no follow-up from where it left.)
-        left: (returned && !abandoned && left_j < run.lin.j).then_some(left),
+        left: (returned && !abandoned).then_some(left),
+        lower: left_j < run.lin.j,
+        plateaus: plateaus(returned, z0, (&left, &left_grad), n),
         sliver: status == Status::Converged && run.sliver && !returned,
     })
 }
@@ -208,13 +202,40 @@ pub(crate) struct SqpEnd<const K: usize> {
     /// Whether the run went back to its best feasible iterate
     /// (`best.rs`).
     pub returned: bool,
-    /// Where it ended before it went back, if its `J` was lower there (not
-    /// where its objective gave it up).
+    /// Where it ended before it went back (not where its objective gave
+    /// it up).
     pub left: Option<[f32; K]>,
+    /// Whether its `J` was lower there than where it went back to.
+    pub lower: bool,
+    /// The depths after the first (bits) that it moved from its start and
+    /// left on a plateau there (`∂J/∂z_j` exactly zero: a saturated dive
+    /// or climb the whole track, whose `J` it no longer sees;
+    /// [`plateaus`]).
+    pub plateaus: u32,
     /// Whether it converged on a step that the line search cut below
     /// [`SLIVER`] of the QP's: the metric that chose the step may be out
     /// of scale, and the end not an optimum.
     pub sliver: bool,
+}
+
+/// The first `n` depths but the first (bits) at which `end` differs
+/// from `start` and the gradient `grad` is exactly zero, if the run
+/// `returned` (else none).
+fn plateaus<const K: usize>(
+    returned: bool,
+    start: &[f32; K],
+    at: (&[f32; K], &[f32; K]),
+    n: usize,
+) -> u32 {
+    let (end, grad) = at;
+    let depths = end.iter().zip(start).zip(grad).zip(0_u32..).take(n.min(32));
+    let flat =
+        |&(((e, s), &g), _): &(((&f32, &f32), &f32), u32)| g == 0.0 && e.to_bits() != s.to_bits();
+    let bits = depths
+        .skip(1)
+        .filter(flat)
+        .fold(0, |b, (_, j)| b | 1_u32.checked_shl(j).unwrap_or(0));
+    if returned { bits } else { 0 }
 }
 
 /// How close to zero (m) a row's `c` counts as active at the end: the
@@ -251,6 +272,16 @@ struct Run<const K: usize> {
 }
 
 impl<const K: usize> Run<K> {
+    /// The run's end into `out`: point, `J`, gradient (and its norm on
+    /// the free variables of `bounds`), `status` and counts.
+    fn report(&self, out: &mut Outcome<K>, bounds: &Bounds<K>, status: Status) {
+        let z = Vector::from(self.z);
+        (out.z, out.j, out.gradient) = (self.z, self.lin.j, self.lin.grad);
+        out.grad_norm = bounds.free_gradient_norm_v(&z, &Vector::from(self.lin.grad));
+        (out.status, out.iterations) = (status, self.iterations);
+        (out.evaluations, out.skipped_updates) = (self.evaluations, self.skipped);
+    }
+
     /// The QP step (`step.rs`); where the QP finds the metric not definite
     /// in f32, the metric is reset to its diagonal and the step solved
     /// again.

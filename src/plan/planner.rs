@@ -54,6 +54,10 @@ pub struct Planner<const K: usize, const N: usize = 3> {
     /// The SQP's plateau scans that kept no point, for the held edges'
     /// pass (`jump/`).
     pub(super) scanned: Scanned<K>,
+    /// Where the last SQP restart ended before it went back to its best
+    /// feasible iterate, and the later depths (bits) it left on plateaus
+    /// there (`restart.rs`, for `stride.rs`).
+    pub(super) restart_plateaus: Option<([f32; K], u32)>,
 }
 
 #[cfg(feature = "defmt")]
@@ -138,6 +142,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             line_j: 0.0,
             blended: 0,
             scanned: Scanned::NONE,
+            restart_plateaus: None,
         })
     }
 

@@ -4,7 +4,7 @@
 //! little short of its targets once more from its end repaired
 //! ([`repaired`], or across the tracks: [`repaired_short`]).
 
-use crate::optim::sqp::sqp_into;
+use crate::optim::sqp::{SqpEnd, sqp_into};
 use crate::optim::{BfgsConfig, Bounds};
 use crate::sim::TrackScore;
 
@@ -79,6 +79,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 tol,
                 &mut self.work,
             );
+            if round == 0 {
+                self.restart_plateaus = restart.as_ref().ok().and_then(on_plateaus);
+            }
             let acc = &mut self.work;
             let v = obj.last_violation;
             let lower = acc.j.partial_cmp(&kept.j) == Some(core::cmp::Ordering::Less);
@@ -95,7 +98,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             // back (before any restore), else the short end repaired.
             let next = restart
                 .ok()
-                .and_then(|end| end.left)
+                .and_then(|end| end.left.filter(|_| end.lower))
                 .filter(|_| round == 0)
                 .and_then(|l| self.edge_toward(obj, &l, tol))
                 .or_else(|| {
@@ -313,4 +316,12 @@ fn lifted_across<const N: usize, const K: usize>(
     let (j, rate) = best.filter(|&(_, r)| r >= ACROSS_RATE)?;
     let raised = crate::num::max(*z.get(j)? - (short + tol) / rate, *bounds.lo.get(j)?);
     Some(with_depth(z, j, raised))
+}
+
+/// Where an SQP run ended before it went back, with the depths it left
+/// on plateaus there (bits), if it left any (`SqpEnd::plateaus`).
+fn on_plateaus<const K: usize>(end: &SqpEnd<K>) -> Option<([f32; K], u32)> {
+    end.left
+        .filter(|_| end.plateaus != 0)
+        .map(|l| (l, end.plateaus))
 }

@@ -237,7 +237,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // −23 400 m³/m: the line's `J` 1.41× the f64 best safe plan's;
         // restarted, 1.005× (1.095× not careful).
         let from = if end.returned {
-            let edge = end.left.and_then(|l| self.edge_toward(obj, &l, tol));
+            let left = end.left.filter(|_| end.lower);
+            let edge = left.and_then(|l| self.edge_toward(obj, &l, tol));
             Some(edge.unwrap_or(self.work.z))
         } else {
             end.sliver.then_some(self.work.z)
