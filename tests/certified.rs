@@ -126,6 +126,37 @@ fn certified_bounds(
     least.len().min(certified.len())
 }
 
+/// [`certified_bounds`] in the `2 half + 1` worlds `world(s)`, `s` evenly
+/// from −1 to 1 across a declared bound; returns the tracks checked.
+fn certified_across(
+    sc: &Scenario<'_, 3>,
+    (bottom, start): (&Profile<8192>, &VehicleState<3>),
+    plan: (&[f32], &[f32]),
+    what: &str,
+    (half, world): (u32, impl Fn(f32) -> World),
+) -> usize {
+    (0..=2 * half)
+        .map(|k| {
+            let w = world(k as f32 / half as f32 - 1.0);
+            certified_bounds(sc, (&w, bottom), start, plan, what)
+        })
+        .sum()
+}
+
+/// The `plan` tool's line for fixture `name` with `args`: each track's
+/// depth and certified altitude (m).
+fn tool_line(name: &str, args: &[&str]) -> (Vec<f32>, Vec<f32>) {
+    let plan = tool::json_of_fixture(name, args);
+    let tracks = plan["tracks"].as_array().unwrap();
+    let value = |k: &str| -> Vec<f32> {
+        tracks
+            .iter()
+            .map(|t| t[k].as_f64().unwrap() as f32)
+            .collect()
+    };
+    (value("depth"), value("certified_min_altitude"))
+}
+
 /// The line planned track by track from `start`, each call from the
 /// state the one before predicted, until a call fails (a start in the
 /// rock): each track's plan.
@@ -413,17 +444,15 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
             let plans = plan_line(&mut planner, sc, &start);
             let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
             let certified: Vec<f32> = plans.iter().map(|p| p.certified_min_altitude).collect();
-            for k in 0..=80 {
-                let world = World {
-                    speed: vehicle.speed(),
-                    flight_path_offset: alpha_max * (k as f32 / 40.0 - 1.0),
-                    vertical_current: 0.0,
-                };
-                for bottom in &shifted {
-                    let plan = (&depths[..], &certified[..]);
-                    let what = format!("{mode:?}");
-                    checked += certified_bounds(sc, (&world, bottom), &start, plan, &what);
-                }
+            let world = |s: f32| World {
+                speed: vehicle.speed(),
+                flight_path_offset: alpha_max * s,
+                vertical_current: 0.0,
+            };
+            for bottom in &shifted {
+                let plan = (&depths[..], &certified[..]);
+                let what = format!("{mode:?}");
+                checked += certified_across(sc, (bottom, &start), plan, &what, (40, world));
             }
         }
         checked
@@ -467,29 +496,17 @@ fn the_certificate_bounds_every_current_between_its_samples() {
     let bottom = Profile::<8192>::new(&x, &b).unwrap();
     let mut checked = 0;
     for args in [&["--mode", "track"][..], &[][..]] {
-        let plan = tool::json_of_fixture("current_fine", args);
-        let tracks = plan["tracks"].as_array().unwrap();
-        let value = |k: &str| -> Vec<f32> {
-            tracks
-                .iter()
-                .map(|t| t[k].as_f64().unwrap() as f32)
-                .collect()
+        let (depths, certified) = tool_line("current_fine", args);
+        let world = |s: f32| World {
+            speed: vehicle.speed(),
+            flight_path_offset: 0.0,
+            vertical_current: w_max * s,
         };
-        let (depths, certified) = (value("depth"), value("certified_min_altitude"));
         checked += with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
             let start = sc.start_state(d0);
-            let mut checked = 0;
-            for k in 0..=160 {
-                let world = World {
-                    speed: vehicle.speed(),
-                    flight_path_offset: 0.0,
-                    vertical_current: w_max * (k as f32 / 80.0 - 1.0),
-                };
-                let plan = (&depths[..], &certified[..]);
-                let what = format!("{args:?}");
-                checked += certified_bounds(sc, (&world, &bottom), &start, plan, &what);
-            }
-            checked
+            let plan = (&depths[..], &certified[..]);
+            let what = format!("{args:?}");
+            certified_across(sc, (&bottom, &start), plan, &what, (80, world))
         });
     }
     assert_eq!(checked, 2 * 161 * 5);
@@ -531,28 +548,16 @@ fn the_certificate_bounds_a_kink_between_its_offsets() {
     let (h_r, h_a) = (66.67, 45.6);
     let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
     let bottom = Profile::<8192>::new(&x, &b).unwrap();
-    let plan = tool::json_of_fixture("offset_kink", &[]);
-    let tracks = plan["tracks"].as_array().unwrap();
-    let value = |k: &str| -> Vec<f32> {
-        tracks
-            .iter()
-            .map(|t| t[k].as_f64().unwrap() as f32)
-            .collect()
+    let (depths, certified) = tool_line("offset_kink", &[]);
+    let world = |s: f32| World {
+        speed: vehicle.speed(),
+        flight_path_offset: alpha_max * s,
+        vertical_current: 0.0,
     };
-    let (depths, certified) = (value("depth"), value("certified_min_altitude"));
     let checked = with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
         let start = sc.start_state(d0);
-        let mut checked = 0;
-        for k in 0..=184 {
-            let world = World {
-                speed: vehicle.speed(),
-                flight_path_offset: alpha_max * (k as f32 / 92.0 - 1.0),
-                vertical_current: 0.0,
-            };
-            let plan = (&depths[..], &certified[..]);
-            checked += certified_bounds(sc, (&world, &bottom), &start, plan, "horizon");
-        }
-        checked
+        let plan = (&depths[..], &certified[..]);
+        certified_across(sc, (&bottom, &start), plan, "horizon", (92, world))
     });
     assert_eq!(checked, 185 * 6);
 }

@@ -224,18 +224,17 @@ pub(crate) struct SqpEnd<const K: usize> {
 fn plateaus<const K: usize>(
     returned: bool,
     start: &[f32; K],
-    at: (&[f32; K], &[f32; K]),
+    (end, grad): (&[f32; K], &[f32; K]),
     n: usize,
 ) -> u32 {
-    let (end, grad) = at;
+    let mut bits = 0_u32;
     let depths = end.iter().zip(start).zip(grad).zip(0_u32..).take(n.min(32));
-    let flat =
-        |&(((e, s), &g), _): &(((&f32, &f32), &f32), u32)| g == 0.0 && e.to_bits() != s.to_bits();
-    let bits = depths
-        .skip(1)
-        .filter(flat)
-        .fold(0, |b, (_, j)| b | 1_u32.checked_shl(j).unwrap_or(0));
-    if returned { bits } else { 0 }
+    for (((e, s), &g), j) in depths.skip(1) {
+        if returned && g == 0.0 && e.to_bits() != s.to_bits() {
+            bits |= 1_u32.checked_shl(j).unwrap_or(0);
+        }
+    }
+    bits
 }
 
 /// How close to zero (m) a row's `c` counts as active at the end: the
