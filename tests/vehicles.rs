@@ -1512,3 +1512,19 @@ fn a_gap_screened_on_a_knife_edge_goes_with_the_move_off_it() {
 fn a_stride_s_restart_leaves_no_depth_on_a_plateau() {
     horizon_within("stride_plateaus", 1.01, 8.309_82e6);
 }
+
+/// A plateau scanned before the call's escapes moved the point
+/// (`check_planner.py --seed 3260 --vehicle
+/// tools/reference/vehicles/slow.toml`, `unseen_3260_6`): the cold call
+/// scanned track 4's plateau (a climb at the pitch limit the whole track,
+/// `∂J/∂z_4` exactly zero) with track 5 at 1 059.7 m and found nothing;
+/// its escapes then moved tracks 3–5 by 40–168 m, leaving track 4 on the
+/// plateau at 571.6 m with track 5 at 892.1 m, where the scan finds
+/// 910.5 m. The later calls skipped the plateau as scanned: the line's
+/// `J` was 1.140× the f64 beam search's best safe plan (8.020 595e6 m³).
+/// A move of more than the band drops the scans, and the next call
+/// scans again: 1.0012×.
+#[test]
+fn a_plateau_scanned_before_the_escapes_moved_the_point_is_scanned_again() {
+    horizon_within("stale_scan", 1.005, 8.020_595e6);
+}

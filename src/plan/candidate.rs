@@ -17,7 +17,7 @@ use super::objective::PlanObjective;
 use super::planner::Warm;
 use super::scan::{BEAM, ScanLog, ScanSpec, scan_start, search_box};
 use super::single::{self, Decision};
-use super::solve::{Merge, later_margin};
+use super::solve::{Merge, ScannedAt, later_margin};
 use super::status::{Found, OptimizerStop};
 use super::{Method, Mode, PlanError, Planner};
 
@@ -200,7 +200,8 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// The candidate of a horizon under BFGS: the SQP from the start
     /// point, on `Σ J` with every track's least altitude at or above the
     /// certified altitude plus the boundary tolerance (module docs of
-    /// `solve`), then verified as any candidate.
+    /// `solve`), then verified as any candidate; the plateaus it scanned
+    /// are skipped next call unless the escapes moved the point.
     fn sqp_candidate(
         &mut self,
         sc: &Scenario<'_, N>,
@@ -223,6 +224,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         let declared = obj.declared();
         obj.gaps = Cell::from_mut(&mut gaps[..]).as_slice_of_cells();
         obj.budget = self.budget.optimizer(fl.count)?;
+        let band = m.reference_altitude() - m.min_altitude();
         if self.cfg.constrained {
             // The later tracks keep a share of the penalty margin: the next
             // calls start from their depths, and from a measured state a
@@ -236,9 +238,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 later_margin(&self.cfg, m)
             };
             obj.target = (s.h_safe + tol, s.h_safe + tol + later);
-            obj.band = (m.reference_altitude() - m.min_altitude()).max(SQP_BAND);
+            obj.band = band.max(SQP_BAND);
         }
-        let skip = s.warm.map_or(0, |w| w.plateaus);
+        let (skip, far) = (
+            s.warm.map_or(0, |w| w.plateaus),
+            s.warm.is_none() && !declared,
+        );
         // Started from the previous continuation (its horizon part, as the
         // optimizer starts, in the box)?
         let start = s.bounds.project(z0);
@@ -250,13 +255,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             self.seed_gaps(sc, &mut obj, (z0, s.h), tol)?;
         }
         self.work.history.clear();
-        let (mut iterations, plateaus) = self.solve_sqp(
-            &mut obj,
-            z0,
-            (s.h, &s.bounds),
-            tol,
-            (skip, s.warm.is_none() && !declared),
-        )?;
+        let (mut iterations, plateaus) =
+            self.solve_sqp(&mut obj, z0, (s.h, &s.bounds), tol, (skip, far))?;
+        let mut plateaus = ScannedAt::new(&self.work.z, plateaus, band);
         let (at, wide) = ((tol, s.h_safe, iterations), (s.h, &s.bounds, s.mu));
         let due = s.warm.is_none_or(|w| w.escapes);
         iterations = self.cold_escapes((&mut obj, fl, scan), wide, at, due);
@@ -267,8 +268,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             let at = (tol, s.h_safe, iterations);
             iterations = self.close_gaps(sc, &mut obj, (s.h, &s.bounds), at)?;
         }
-        let answer = (iterations, previous_j);
-        self.finish((fl, s, scan), (&obj, None), answer, (0.0, plateaus, owed))
+        plateaus.at(&self.work.z);
+        let (answer, warm) = ((iterations, previous_j), (0.0, plateaus.bits, owed));
+        self.finish((fl, s, scan), (&obj, None), answer, warm)
     }
 
     /// The scan's decision of a constrained single track (module docs of
