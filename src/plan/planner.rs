@@ -82,7 +82,8 @@ pub(super) struct Warm<const K: usize> {
     /// The penalty weight the previous call ended with.
     pub mu: f32,
     /// Horizon positions (bit `j`: `track + j`) whose plateau the previous
-    /// call's SQP scanned already (`solve.rs`).
+    /// call's SQP scanned already, none of the other depths moved since by
+    /// more than `h_r − h_a` (`solve.rs`'s `ScannedAt`).
     pub plateaus: u64,
     /// The previous call was due the cold call's escapes (`wider.rs`) and
     /// ended infeasible, where they do not run: this call runs them.
