@@ -1528,3 +1528,19 @@ fn a_stride_s_restart_leaves_no_depth_on_a_plateau() {
 fn a_plateau_scanned_before_the_escapes_moved_the_point_is_scanned_again() {
     horizon_within("stale_scan", 1.005, 8.020_595e6);
 }
+
+/// The next track's end on its waypoint's knife edge in a saturated
+/// climb (`check_planner.py --seed 3267`, default vehicle,
+/// `unseen_3267_0`): track 3 climbs at the pitch limit the whole track
+/// and ends 0.3 mm short of waypoint 3 whatever its depth. No call could
+/// move it; committed on the edge, every later certificate flew the other
+/// switch too, from which track 4's least altitude (set by its arrival)
+/// is 59.976 m against 60.094 m, and the last call climbed track 4 157 m
+/// above the best plan's depth: the line's `J` was 2.52× the f64 beam
+/// search's best safe plan (4.663 829e6 m³). The call for track 2 now
+/// moves its depth 1.8 cm, so that track 3's sample before the waypoint
+/// lies 4 mm short of it: 1.0004×.
+#[test]
+fn a_next_track_s_end_on_a_knife_edge_is_moved_off_by_the_depth_before() {
+    horizon_within("edge_ahead", 1.005, 4.663_829e6);
+}

@@ -81,6 +81,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // a single track's floor set by its arrival, `single.rs`.)
         c.h_safe = c.h_safe.min(self.cfg.certified_altitude(sc.mission()));
         self.off_the_edge(sc, state, track, &mut c);
+        self.off_the_edge_ahead(sc, state, track, &mut c);
         Ok(c)
     }
 

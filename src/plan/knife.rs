@@ -106,10 +106,10 @@ use super::scan::search_box;
 use super::{Mode, Planner};
 
 /// First probe, m of depth.
-const PROBE: f32 = 5e-3;
+pub(super) const PROBE: f32 = 5e-3;
 
 /// Longest move, m of depth.
-const MOST: f32 = 0.25;
+pub(super) const MOST: f32 = 0.25;
 
 /// Under declared motion, the half-width (m) of the knife edge within
 /// which a kept continuation is left for the candidate (module docs).
@@ -342,7 +342,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
 
     /// Whether a moved depth's flight `f`, its nearest sample at `v` from
     /// the waypoint, may replace the candidate (module docs).
-    fn keeps(&self, cand: &Candidate<N>, f: &Flown<N>, v: f32, (lo, hi): (f32, f32)) -> bool {
+    pub(super) fn keeps(
+        &self,
+        cand: &Candidate<N>,
+        f: &Flown<N>,
+        v: f32,
+        (lo, hi): (f32, f32),
+    ) -> bool {
         let (s0, s): (&TrackScore, &TrackScore) = (&cand.flown.score, &f.score);
         let floor = s0.min_altitude().min(cand.h_safe);
         let safe = !self.cfg.constrained || s.min_altitude() >= floor;

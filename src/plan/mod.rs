@@ -135,6 +135,7 @@
 //! | `single.rs` | the constrained single track's decision from its scan |
 //! | `fallback.rs` | the closest safe depth, the safe-set boundary |
 
+mod ahead;
 mod answer;
 mod bottom;
 mod budget;
