@@ -27,7 +27,9 @@
 //! dive through the waypoint), the depth is kept, and the edge stays: on
 //! `check_planner.py --seed 1801`, `unseen_1801_6` (horizon), track 4's
 //! climb reaches waypoint 4 0.1 mm past it whatever its depth, and track
-//! 5's `J` differs from the f64 re-simulation's by 2.1e-3.
+//! 5's `J` differs from the f64 re-simulation's by 2.1e-3. In horizon
+//! mode the call before moves its own depth for such a track where it
+//! can (`ahead.rs`).
 //!
 //! The move is made under declared uncertainty too, shallower only: the
 //! declared worlds then certify the moved depth, which costs no more than
