@@ -9,21 +9,27 @@
 //! other switch too (`certify/flight.rs`). That other switch can set the
 //! track after it centimetres lower, and the line pays for it:
 //! `check_planner.py --seed 3267` (default vehicle, `unseen_3267_0`):
-//! track 3 climbs at the pitch limit the whole track and ends 0.1 mm from
-//! waypoint 3 whatever its depth; from the other switch's state track 4's
-//! least altitude, set by its arrival, is 11.7 cm lower (59.976 m against
-//! 60.094 m); the last call aimed track 4 above that and dived 157 m short
-//! of the best plan's depth: the line 2.52× the f64 best safe plan.
+//! track 3 climbs at the pitch limit the whole track and ends 0.3 mm short
+//! of waypoint 3 whatever its depth; from the other switch's state track
+//! 4's least altitude, set by its arrival, is 11.7 cm lower (59.976 m
+//! against 60.094 m); the last call aimed track 4 above that and climbed
+//! it 157 m above the best plan's depth: the line 2.52× the f64 best safe
+//! plan.
 //!
 //! So the call before moves its own depth, in the candidate's horizon, as
-//! `knife.rs` moves it for its own end: a probe, then a secant step that
-//! puts the next track's nearest sample twice [`EDGE`] from its waypoint,
-//! shallower first, each flown over both tracks; kept when the candidate's
-//! own track stays off its edge and as safe, its `J` within the knife's
-//! share, and the next track as safe as it was. The later tracks' gaps go
-//! with the move (`knife.rs`). Only with one vehicle world, unbudgeted, in
-//! horizon mode: one flight of the next track per call to see the edge,
-//! and two more to see that the next depth cannot move it.
+//! `knife.rs` moves it for its own end: a probe 5 mm shallower, then a
+//! secant step that puts the next track's nearest sample twice [`EDGE`]
+//! from its waypoint on the side it lies now, each flown over both tracks.
+//! The side keeps the switch on the sample the horizon planned with, so
+//! the tracks after fly as planned: moved to the other side (the sample
+//! 4 mm past the waypoint, a switch a sample earlier), track 4 flew
+//! 59.998 m, and the line stayed 2.50×. A move is kept when the
+//! candidate's own track stays off its edge and as safe, its `J` within
+//! the knife's share, and the next track as safe as it was; the later
+//! tracks' gaps go with it (`knife.rs`). Only with one vehicle world,
+//! unbudgeted, in horizon mode: one flight of the next track per call to
+//! see the edge, two more to see that the next depth cannot move it, and
+//! four for the move.
 
 use crate::sim::{EDGE, Scenario, TrackScore, VehicleState, offset};
 
