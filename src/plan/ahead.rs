@@ -68,22 +68,11 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         if !wanted || sc.on_edge(track, &cand.flown.next) {
             return;
         }
-        let mut fl = Flights {
-            sc: self.penalized(sc, self.horizon_len),
-            state,
-            track,
-            count: cand.evaluations,
-            limit: u32::MAX,
-        };
+        let mut fl = self.move_flights((sc, state, track), cand, u32::MAX);
         let found = self.move_for_next(&mut fl, cand, (z_next, end));
         cand.evaluations = fl.count;
         if let Some(f) = found {
-            cand.flown = f;
-            if let Some(first) = self.work.z.first_mut() {
-                *first = f.depth;
-            }
-            let later = self.gaps.get_mut(next..).unwrap_or(&mut []);
-            later.iter_mut().for_each(|g| *g = 0.0);
+            self.take_move(cand, track, f);
         }
     }
 

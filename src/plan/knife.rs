@@ -151,14 +151,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             return;
         }
         let v0 = offset(&cand.flown.next, end);
-        let mut fl = Flights {
-            // (The candidate's own flights' scenario.)
-            sc: self.penalized(sc, self.horizon_len),
-            state,
-            track,
-            count: cand.evaluations,
-            limit: self.budget.candidate,
-        };
+        let mut fl = self.move_flights((sc, state, track), cand, self.budget.candidate);
         let b = search_box::<N, 1>(sc, state, track, 1);
         let (lo, hi) = (b.lo.first().copied(), b.hi.first().copied());
         let box_ = (lo.unwrap_or(f32::NAN), hi.unwrap_or(f32::NAN));
@@ -173,18 +166,42 @@ impl<const K: usize, const N: usize> Planner<K, N> {
             .find_map(|&side| self.move_off(&mut fl, cand, (end, v0), side, box_));
         cand.evaluations = fl.count;
         if let Some(f) = found {
-            cand.flown = f;
-            if let Some(first) = self.work.z.first_mut() {
-                *first = f.depth;
-            }
-            // The later tracks' gaps were screened from the depth on the
-            // edge: the next calls screen their own.
-            let later = self
-                .gaps
-                .get_mut(track.saturating_add(1)..)
-                .unwrap_or(&mut []);
-            later.iter_mut().for_each(|g| *g = 0.0);
+            self.take_move(cand, track, f);
         }
+    }
+
+    /// The flights of a move of the candidate's depth from `state` on
+    /// `track`: the candidate's own flights' scenario, counted on from
+    /// its evaluations, at most `limit`.
+    pub(super) fn move_flights<'s, 'a>(
+        &self,
+        (sc, state, track): (&Scenario<'a, N>, &'s VehicleState<N>, usize),
+        cand: &Candidate<N>,
+        limit: u32,
+    ) -> Flights<'s, 'a, N> {
+        Flights {
+            sc: self.penalized(sc, self.horizon_len),
+            state,
+            track,
+            count: cand.evaluations,
+            limit,
+        }
+    }
+
+    /// The candidate moved to `f` (its depth, first in the workspace's
+    /// horizon too). The later tracks' gaps were screened from the depth
+    /// before the move, which a knife edge's other switch may have set:
+    /// the next calls screen their own.
+    pub(super) fn take_move(&mut self, cand: &mut Candidate<N>, track: usize, f: Flown<N>) {
+        cand.flown = f;
+        if let Some(first) = self.work.z.first_mut() {
+            *first = f.depth;
+        }
+        let later = self
+            .gaps
+            .get_mut(track.saturating_add(1)..)
+            .unwrap_or(&mut []);
+        later.iter_mut().for_each(|g| *g = 0.0);
     }
 
     /// With one vehicle world ([`one_vehicle`]), where the committed
