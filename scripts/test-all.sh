@@ -24,9 +24,10 @@ say "host: property tests, 10,000 random terrains (release)"
 cargo test --release --test properties -- --nocapture
 
 say "host: recursive feasibility, 1,500 random lines against a whole-line search; certificate in sampled worlds (release)"
-# tests/certified.rs also runs the release `plan` binary (the tool's line).
+# tests/certified.rs and tests/between.rs also run the release `plan`
+# binary (the tool's line).
 cargo build --release --example plan
-cargo test --release --test feasibility --test certified -- --nocapture
+cargo test --release --test feasibility --test certified --test between -- --nocapture
 
 say "target: the library builds for Cortex-M4F (thumbv7em-none-eabihf), with and without defmt"
 cargo build --lib --release --target thumbv7em-none-eabihf

@@ -10,14 +10,16 @@
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::float_cmp)]
 #![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
 
+mod across;
 mod common;
 mod tool;
 
+use across::{certified_across, fixture_line, fly};
 use auvnav::{
-    Mission, Mode, PidGains, Plan, Planner, PlannerConfig, Profile, Scenario, TrackScore,
-    TransferFunction, Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints, World,
+    Mission, Mode, PidGains, Plan, Planner, PlannerConfig, Profile, Scenario, TransferFunction,
+    Uncertainty, Vehicle, VehicleConfig, VehicleState, Waypoints, World,
 };
-use common::{csv_column, real_profile, real_waypoints, with_declared};
+use common::{real_profile, real_waypoints, with_declared};
 
 struct Lcg(u64);
 impl Lcg {
@@ -72,89 +74,6 @@ fn world_bottom(
         })
         .collect();
     Profile::new(&xs, &bs).unwrap()
-}
-
-/// The least altitude of each track of `depths` flown open loop from
-/// `start` in `world` over `bottom`.
-fn fly(
-    sc: &Scenario<'_, 3>,
-    world: &World,
-    bottom: &Profile<8192>,
-    start: &VehicleState<3>,
-    depths: &[f32],
-) -> Vec<f32> {
-    let scw = sc.in_world(world, bottom.view()).unwrap();
-    let mut s = vec![TrackScore::default(); depths.len()];
-    match scw.simulate(start, 0, depths, &mut s, |_| {}) {
-        Ok(_) => s.iter().map(TrackScore::min_altitude).collect(),
-        Err(_) => vec![f32::NEG_INFINITY; depths.len()],
-    }
-}
-
-/// Fixture `name` of `tests/fixtures/horizon/`: its map's samples (x and
-/// bottom depth, m), the map and its waypoints.
-fn fixture_line(name: &str) -> (Vec<f32>, Vec<f32>, Profile<4096>, Waypoints<16>) {
-    let rel = format!("tests/fixtures/horizon/{name}");
-    let (x, b) = (
-        csv_column(&format!("{rel}.csv"), 0),
-        csv_column(&format!("{rel}.csv"), 1),
-    );
-    let map = Profile::<4096>::new(&x, &b).unwrap();
-    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
-    (x, b, map, wps)
-}
-
-/// Flies `depths` from `start` in `world` over `bottom` and asserts that
-/// each track's certified altitude (`certified`, m) is at most its least
-/// altitude there (1 mm allowed); `what` names the plan. Returns the
-/// tracks checked.
-fn certified_bounds(
-    sc: &Scenario<'_, 3>,
-    (world, bottom): (&World, &Profile<8192>),
-    start: &VehicleState<3>,
-    (depths, certified): (&[f32], &[f32]),
-    what: &str,
-) -> usize {
-    let least = fly(sc, world, bottom, start, depths);
-    for (t, (&h, &c)) in least.iter().zip(certified).enumerate() {
-        assert!(
-            c <= h + 1e-3,
-            "{what} track {}: certified {c} m, flies {h} m in {world:?}",
-            t + 1
-        );
-    }
-    least.len().min(certified.len())
-}
-
-/// [`certified_bounds`] in the `2 half + 1` worlds `world(s)`, `s` evenly
-/// from −1 to 1 across a declared bound; returns the tracks checked.
-fn certified_across(
-    sc: &Scenario<'_, 3>,
-    (bottom, start): (&Profile<8192>, &VehicleState<3>),
-    plan: (&[f32], &[f32]),
-    what: &str,
-    (half, world): (u32, impl Fn(f32) -> World),
-) -> usize {
-    (0..=2 * half)
-        .map(|k| {
-            let w = world(k as f32 / half as f32 - 1.0);
-            certified_bounds(sc, (&w, bottom), start, plan, what)
-        })
-        .sum()
-}
-
-/// The `plan` tool's line for fixture `name` with `args`: each track's
-/// depth and certified altitude (m).
-fn tool_line(name: &str, args: &[&str]) -> (Vec<f32>, Vec<f32>) {
-    let plan = tool::json_of_fixture(name, args);
-    let tracks = plan["tracks"].as_array().unwrap();
-    let value = |k: &str| -> Vec<f32> {
-        tracks
-            .iter()
-            .map(|t| t[k].as_f64().unwrap() as f32)
-            .collect()
-    };
-    (value("depth"), value("certified_min_altitude"))
 }
 
 /// The line planned track by track from `start`, each call from the
@@ -458,108 +377,6 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
         checked
     });
     assert!(checked > 600, "{checked}");
-}
-
-/// The vertical current declared alone (`check_certified.py --seed 2553
-/// --bounds-kind motion`, `synthetic_011`, fixture `current_fine`): the
-/// `plan` tool's line, track by track and in horizon mode. Track 5's climb
-/// saturates and the corner world `w_max` drops it 37 m below the nominal
-/// flight. With five levels of `w` a world at 0.0555 m/s, between 0.0371
-/// and 0.0742, flew track 5 0.15 m under its certified altitude in track
-/// mode; the nine levels used where `w` is declared alone catch it. Each
-/// track's certified altitude is at most its least altitude in 161 worlds
-/// across the declared current.
-#[test]
-fn the_certificate_bounds_every_current_between_its_samples() {
-    let mut cfg = VehicleConfig {
-        speed: 1.437,
-        sample_time: 0.0873,
-        ..VehicleConfig::default()
-    };
-    cfg.autopilot.pitch_limit = 13.56;
-    cfg.autopilot.depth_pid = PidGains {
-        kp: 1.858,
-        ki: 0.02291,
-        kd: 1.547,
-    };
-    cfg.autopilot.pitch_pid = PidGains {
-        kp: 1.734,
-        ki: 0.1259,
-        kd: 2.254,
-    };
-    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
-    let w_max = 0.0742;
-    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, 0.0, w_max).unwrap();
-    let (x, b, map, wps) = fixture_line("current_fine");
-    let (h_r, h_a) = (41.13, 20.53);
-    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
-    let bottom = Profile::<8192>::new(&x, &b).unwrap();
-    let mut checked = 0;
-    for args in [&["--mode", "track"][..], &[][..]] {
-        let (depths, certified) = tool_line("current_fine", args);
-        let world = |s: f32| World {
-            speed: vehicle.speed(),
-            flight_path_offset: 0.0,
-            vertical_current: w_max * s,
-        };
-        checked += with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
-            let start = sc.start_state(d0);
-            let plan = (&depths[..], &certified[..]);
-            let what = format!("{args:?}");
-            certified_across(sc, (&bottom, &start), plan, &what, (80, world))
-        });
-    }
-    assert_eq!(checked, 2 * 161 * 5);
-}
-
-/// The flight-path offset declared alone (`check_certified.py --seed 3218
-/// --bounds-kind motion`, `synthetic_098`, fixture `offset_kink`, a
-/// second-order plant): the `plan` tool's horizon line. Track 6's least
-/// altitude against `α` is the lower of two branches, one falling to
-/// 55.10 m at −0.62° and one rising from there: a kink between the levels
-/// −0.92° and −0.46° (about 56 m each), under the certificate of the
-/// sampled levels less the vehicle margin (55.52 m). The floors between a
-/// line's levels (`certify/valley.rs`) bound it. Each track's certified
-/// altitude is at most its least altitude in 185 worlds across the
-/// declared offset.
-#[test]
-fn the_certificate_bounds_a_kink_between_its_offsets() {
-    let mut cfg = VehicleConfig {
-        speed: 0.8409,
-        sample_time: 0.248,
-        ..VehicleConfig::default()
-    };
-    cfg.autopilot.pitch_limit = 29.91;
-    cfg.autopilot.depth_pid = PidGains {
-        kp: 1.356,
-        ki: 0.02944,
-        kd: 1.867,
-    };
-    cfg.autopilot.pitch_pid = PidGains {
-        kp: 1.451,
-        ki: 0.1041,
-        kd: 2.88,
-    };
-    let plant = TransferFunction::<3>::pitch(&[-0.62], &[1.0, 1.45, 0.29]).unwrap();
-    let vehicle = Vehicle::new(&cfg, plant).unwrap();
-    let alpha_max = 1.84;
-    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
-    let (x, b, map, wps) = fixture_line("offset_kink");
-    let (h_r, h_a) = (66.67, 45.6);
-    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
-    let bottom = Profile::<8192>::new(&x, &b).unwrap();
-    let (depths, certified) = tool_line("offset_kink", &[]);
-    let world = |s: f32| World {
-        speed: vehicle.speed(),
-        flight_path_offset: alpha_max * s,
-        vertical_current: 0.0,
-    };
-    let checked = with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
-        let start = sc.start_state(d0);
-        let plan = (&depths[..], &certified[..]);
-        certified_across(sc, (&bottom, &start), plan, "horizon", (92, world))
-    });
-    assert_eq!(checked, 185 * 6);
 }
 
 /// With nothing declared, every track's `certified_min_altitude` is its

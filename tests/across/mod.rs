@@ -1,0 +1,95 @@
+//! Shared by the tests that sample the worlds a certificate claims
+//! (`tests/certified.rs`, `tests/between.rs`): one open-loop flight of a
+//! plan in a world, the fixtures' lines, the `plan` tool's line, and the
+//! check that each certified altitude is at most the flown one.
+#![allow(dead_code)]
+#![allow(clippy::unwrap_used, clippy::indexing_slicing)]
+#![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
+
+use auvnav::{Profile, Scenario, TrackScore, VehicleState, Waypoints, World};
+
+use crate::common::csv_column;
+use crate::tool;
+
+/// The least altitude of each track of `depths` flown open loop from
+/// `start` in `world` over `bottom`.
+pub fn fly(
+    sc: &Scenario<'_, 3>,
+    world: &World,
+    bottom: &Profile<8192>,
+    start: &VehicleState<3>,
+    depths: &[f32],
+) -> Vec<f32> {
+    let scw = sc.in_world(world, bottom.view()).unwrap();
+    let mut s = vec![TrackScore::default(); depths.len()];
+    match scw.simulate(start, 0, depths, &mut s, |_| {}) {
+        Ok(_) => s.iter().map(TrackScore::min_altitude).collect(),
+        Err(_) => vec![f32::NEG_INFINITY; depths.len()],
+    }
+}
+
+/// Fixture `name` of `tests/fixtures/horizon/`: its map's samples (x and
+/// bottom depth, m), the map and its waypoints.
+pub fn fixture_line(name: &str) -> (Vec<f32>, Vec<f32>, Profile<4096>, Waypoints<16>) {
+    let rel = format!("tests/fixtures/horizon/{name}");
+    let (x, b) = (
+        csv_column(&format!("{rel}.csv"), 0),
+        csv_column(&format!("{rel}.csv"), 1),
+    );
+    let map = Profile::<4096>::new(&x, &b).unwrap();
+    let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
+    (x, b, map, wps)
+}
+
+/// Flies `depths` from `start` in `world` over `bottom` and asserts that
+/// each track's certified altitude (`certified`, m) is at most its least
+/// altitude there (1 mm allowed); `what` names the plan. Returns the
+/// tracks checked.
+pub fn certified_bounds(
+    sc: &Scenario<'_, 3>,
+    (world, bottom): (&World, &Profile<8192>),
+    start: &VehicleState<3>,
+    (depths, certified): (&[f32], &[f32]),
+    what: &str,
+) -> usize {
+    let least = fly(sc, world, bottom, start, depths);
+    for (t, (&h, &c)) in least.iter().zip(certified).enumerate() {
+        assert!(
+            c <= h + 1e-3,
+            "{what} track {}: certified {c} m, flies {h} m in {world:?}",
+            t + 1
+        );
+    }
+    least.len().min(certified.len())
+}
+
+/// [`certified_bounds`] in the `2 half + 1` worlds `world(s)`, `s` evenly
+/// from −1 to 1 across a declared bound; returns the tracks checked.
+pub fn certified_across(
+    sc: &Scenario<'_, 3>,
+    (bottom, start): (&Profile<8192>, &VehicleState<3>),
+    plan: (&[f32], &[f32]),
+    what: &str,
+    (half, world): (u32, impl Fn(f32) -> World),
+) -> usize {
+    (0..=2 * half)
+        .map(|k| {
+            let w = world(k as f32 / half as f32 - 1.0);
+            certified_bounds(sc, (&w, bottom), start, plan, what)
+        })
+        .sum()
+}
+
+/// The `plan` tool's line for fixture `name` with `args`: each track's
+/// depth and certified altitude (m).
+pub fn tool_line(name: &str, args: &[&str]) -> (Vec<f32>, Vec<f32>) {
+    let plan = tool::json_of_fixture(name, args);
+    let tracks = plan["tracks"].as_array().unwrap();
+    let value = |k: &str| -> Vec<f32> {
+        tracks
+            .iter()
+            .map(|t| t[k].as_f64().unwrap() as f32)
+            .collect()
+    };
+    (value("depth"), value("certified_min_altitude"))
+}

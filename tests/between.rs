@@ -1,0 +1,169 @@
+//! The certificate between its sampled worlds (model contract §12): the
+//! vehicle part of a certificate flies a few levels of each declared
+//! bound, and its altitudes are lowered by the vehicle margin and bounded
+//! by the floors between the levels (`src/plan/certify/`). Each test
+//! takes a line on which the checker (`check_certified.py`) once found a
+//! world between the samples flying under the certificate, and flies the
+//! `plan` tool's depths in many worlds across the declared bound: every
+//! track's certified altitude must be at most its least altitude in each.
+#![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::float_cmp)]
+#![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
+
+mod across;
+mod common;
+mod tool;
+
+use across::{certified_across, fixture_line, tool_line};
+use auvnav::{PidGains, Profile, TransferFunction, Uncertainty, Vehicle, VehicleConfig, World};
+use common::with_declared;
+
+/// The vertical current declared alone (`check_certified.py --seed 2553
+/// --bounds-kind motion`, `synthetic_011`, fixture `current_fine`): the
+/// `plan` tool's line, track by track and in horizon mode. Track 5's climb
+/// saturates and the corner world `w_max` drops it 37 m below the nominal
+/// flight. With five levels of `w` a world at 0.0555 m/s, between 0.0371
+/// and 0.0742, flew track 5 0.15 m under its certified altitude in track
+/// mode; the nine levels used where `w` is declared alone catch it. Each
+/// track's certified altitude is at most its least altitude in 161 worlds
+/// across the declared current.
+#[test]
+fn the_certificate_bounds_every_current_between_its_samples() {
+    let mut cfg = VehicleConfig {
+        speed: 1.437,
+        sample_time: 0.0873,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 13.56;
+    cfg.autopilot.depth_pid = PidGains {
+        kp: 1.858,
+        ki: 0.02291,
+        kd: 1.547,
+    };
+    cfg.autopilot.pitch_pid = PidGains {
+        kp: 1.734,
+        ki: 0.1259,
+        kd: 2.254,
+    };
+    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
+    let w_max = 0.0742;
+    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, 0.0, w_max).unwrap();
+    let (x, b, map, wps) = fixture_line("current_fine");
+    let (h_r, h_a) = (41.13, 20.53);
+    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
+    let bottom = Profile::<8192>::new(&x, &b).unwrap();
+    let mut checked = 0;
+    for args in [&["--mode", "track"][..], &[][..]] {
+        let (depths, certified) = tool_line("current_fine", args);
+        let world = |s: f32| World {
+            speed: vehicle.speed(),
+            flight_path_offset: 0.0,
+            vertical_current: w_max * s,
+        };
+        checked += with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
+            let start = sc.start_state(d0);
+            let plan = (&depths[..], &certified[..]);
+            let what = format!("{args:?}");
+            certified_across(sc, (&bottom, &start), plan, &what, (80, world))
+        });
+    }
+    assert_eq!(checked, 2 * 161 * 5);
+}
+
+/// The flight-path offset declared alone (`check_certified.py --seed 3218
+/// --bounds-kind motion`, `synthetic_098`, fixture `offset_kink`, a
+/// second-order plant): the `plan` tool's horizon line. Track 6's least
+/// altitude against `α` is the lower of two branches, one falling to
+/// 55.10 m at −0.62° and one rising from there: a kink between the levels
+/// −0.92° and −0.46° (about 56 m each), under the certificate of the
+/// sampled levels less the vehicle margin (55.52 m). The floors between a
+/// line's levels (`certify/valley.rs`) bound it. Each track's certified
+/// altitude is at most its least altitude in 185 worlds across the
+/// declared offset.
+#[test]
+fn the_certificate_bounds_a_kink_between_its_offsets() {
+    let mut cfg = VehicleConfig {
+        speed: 0.8409,
+        sample_time: 0.248,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 29.91;
+    cfg.autopilot.depth_pid = PidGains {
+        kp: 1.356,
+        ki: 0.02944,
+        kd: 1.867,
+    };
+    cfg.autopilot.pitch_pid = PidGains {
+        kp: 1.451,
+        ki: 0.1041,
+        kd: 2.88,
+    };
+    let plant = TransferFunction::<3>::pitch(&[-0.62], &[1.0, 1.45, 0.29]).unwrap();
+    let vehicle = Vehicle::new(&cfg, plant).unwrap();
+    let alpha_max = 1.84;
+    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
+    let (x, b, map, wps) = fixture_line("offset_kink");
+    let (h_r, h_a) = (66.67, 45.6);
+    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
+    let bottom = Profile::<8192>::new(&x, &b).unwrap();
+    let (depths, certified) = tool_line("offset_kink", &[]);
+    let world = |s: f32| World {
+        speed: vehicle.speed(),
+        flight_path_offset: alpha_max * s,
+        vertical_current: 0.0,
+    };
+    let checked = with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
+        let start = sc.start_state(d0);
+        let plan = (&depths[..], &certified[..]);
+        certified_across(sc, (&bottom, &start), plan, "horizon", (92, world))
+    });
+    assert_eq!(checked, 185 * 6);
+}
+
+/// The speed error declared alone, 0.918 % (`check_certified.py --seed
+/// 3262 --bounds-kind motion`, `synthetic_021`, fixture `speed_phase`):
+/// the `plan` tool's line, in horizon mode and track by track. Tracks 3
+/// and 4 are 85 and 166 m long, and each waypoint's switch comes at a
+/// speed's own sample: between the three sampled speeds the least
+/// altitude of track 3 has a fine structure of about 9 cm from the phases
+/// of the switches before it. A speed between them flew track 3 8.4 cm
+/// under the sampled ones, where the vehicle margin was the larger of 15
+/// s of drift (3.5 cm) and one sample's climb (5.9 cm); it is now their
+/// sum. Each track's certified altitude is at most its least altitude in
+/// 801 worlds across the declared speed.
+#[test]
+fn the_certificate_bounds_every_speed_between_its_samples() {
+    let mut cfg = VehicleConfig {
+        speed: 0.9309,
+        sample_time: 0.224,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 15.75;
+    cfg.autopilot.depth_pid = PidGains {
+        kp: 1.44,
+        ki: 0.0,
+        kd: 1.808,
+    };
+    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
+    let eps = 0.00918;
+    let u = Uncertainty::new(0.0, 0.0, 0.0, eps, 0.0, 0.0).unwrap();
+    let (x, b, map, wps) = fixture_line("speed_phase");
+    let (h_r, h_a) = (25.11, 10.41);
+    let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
+    let bottom = Profile::<8192>::new(&x, &b).unwrap();
+    let mut checked = 0;
+    for args in [&[][..], &["--mode", "track"][..]] {
+        let (depths, certified) = tool_line("speed_phase", args);
+        let world = |s: f32| World {
+            speed: vehicle.speed() * (1.0 + eps * s),
+            flight_path_offset: 0.0,
+            vertical_current: 0.0,
+        };
+        checked += with_declared(&vehicle, (&map, &wps), (h_r, h_a), u, |sc| {
+            let start = sc.start_state(d0);
+            let plan = (&depths[..], &certified[..]);
+            let what = format!("{args:?}");
+            certified_across(sc, (&bottom, &start), plan, &what, (400, world))
+        });
+    }
+    assert_eq!(checked, 2 * 801 * 4);
+}
