@@ -127,9 +127,9 @@ fn the_certificate_bounds_a_kink_between_its_offsets() {
 /// altitude of track 3 has a fine structure of about 9 cm from the phases
 /// of the switches before it. A speed between them flew track 3 8.4 cm
 /// under the sampled ones, where the vehicle margin was the larger of 15
-/// s of drift (3.5 cm) and one sample's climb (5.9 cm); it is now their
-/// sum. Each track's certified altitude is at most its least altitude in
-/// 801 worlds across the declared speed.
+/// s of drift (3.5 cm) and one sample's climb (5.9 cm); its floor is now
+/// two samples' climb. Each track's certified altitude is at most its
+/// least altitude in 801 worlds across the declared speed.
 #[test]
 fn the_certificate_bounds_every_speed_between_its_samples() {
     let mut cfg = VehicleConfig {

@@ -125,8 +125,8 @@ const J_SHARE: f32 = 1e-3;
 /// no state, so every world switches where the nominal flight does). Then
 /// a knife edge's other switch is flown as a world of its own. Under
 /// declared motion (speed, path offset, current) each world switches at
-/// its own sample, and the sample's climb in the vehicle margin covers
-/// the switch (`certify/mod.rs`, `flight.rs`).
+/// its own sample, and the vehicle margin's floor of two samples' climb
+/// covers the switch (`certify/mod.rs`, `flight.rs`).
 pub(super) fn one_vehicle<const N: usize>(sc: &Scenario<'_, N>) -> bool {
     !sc.mission().uncertainty().motion_uncertain()
 }

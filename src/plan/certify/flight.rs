@@ -22,8 +22,7 @@ use crate::sim::{Scenario, SimError, TrackScore, VehicleState, World};
 /// arithmetic may switch the other way, and the next track's least
 /// altitude can move by a tenth of a metre (`check_planner.py --seed
 /// 2585`, `unseen_2585_5`: 60.09 m in f32, 59.974 m in f64, below `h_a`).
-/// Under declared motion the vehicle margin's sample's climb covers it
-/// instead.
+/// Under declared motion the vehicle margin's floor covers it instead.
 /// (Not inlined: its callers share one copy of the flight. A branch flies
 /// from the world's start again, after the first flight rather than
 /// inside it, so that a certificate's stack holds one flight at a time.)
