@@ -4,8 +4,9 @@
 //! by the floors between the levels (`src/plan/certify/`). Each test
 //! takes a line on which the checker (`check_certified.py`) once found a
 //! world between the samples flying under the certificate, and flies the
-//! `plan` tool's depths in many worlds across the declared bound: every
-//! track's certified altitude must be at most its least altitude in each.
+//! depths the `plan` tool (or the planner, call by call) commits there in
+//! many worlds across the declared bound: every track's certified
+//! altitude must be at most its least altitude in each.
 #![allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::float_cmp)]
 #![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
 
@@ -13,8 +14,11 @@ mod across;
 mod common;
 mod tool;
 
-use across::{certified_across, fixture_line, tool_line};
-use auvnav::{PidGains, Profile, TransferFunction, Uncertainty, Vehicle, VehicleConfig, World};
+use across::{Lcg, certified_across, fixture_line, plan_line, tool_line, world_bottom};
+use auvnav::{
+    Mode, PidGains, Planner, PlannerConfig, Profile, TransferFunction, Uncertainty, Vehicle,
+    VehicleConfig, World,
+};
 use common::with_declared;
 
 /// The vertical current declared alone (`check_certified.py --seed 2553
@@ -166,4 +170,67 @@ fn the_certificate_bounds_every_speed_between_its_samples() {
         });
     }
     assert_eq!(checked, 2 * 801 * 4);
+}
+
+/// With little vehicle uncertainty declared (a flight-path offset of
+/// 0.065°, a map known to 6.88 m along track), the worlds between the
+/// certificate's samples cross each waypoint up to a sample before or
+/// after them, and their flights after the switch are shifted by as much.
+/// A vehicle margin of 15 s of drift (27 mm) did not cover it: on this
+/// random line and vehicle (`check_certified.py --seed 2431`,
+/// `synthetic_031`, fixture `offset_jitter`), an interior offset flew track
+/// 4 40 mm under the corners. One sample's climb at the pitch limit
+/// (72 mm) does. Each track's certified altitude is at most its least
+/// altitude in 81 worlds across the declared offset, over the map shifted
+/// either way.
+#[test]
+fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
+    let mut cfg = VehicleConfig {
+        speed: 1.565,
+        sample_time: 0.185,
+        ..VehicleConfig::default()
+    };
+    cfg.autopilot.pitch_limit = 13.94;
+    cfg.autopilot.elevator_limit = 16.84;
+    cfg.autopilot.pitch_pid = PidGains {
+        kp: 1.696,
+        ki: 0.1005,
+        kd: 2.204,
+    };
+    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
+    let alpha_max = 0.0649;
+    let u = Uncertainty::new(6.88, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
+    let (_, _, map, wps) = fixture_line("offset_jitter");
+    let x0 = wps.positions()[0];
+    let mut rng = Lcg(0x2431_0ff5);
+    let shifted: Vec<Profile<8192>> = [1.0, -1.0]
+        .iter()
+        .map(|&s| world_bottom(&map, &u, x0, &mut rng, Some((s, 0.0))))
+        .collect();
+    let checked = with_declared(&vehicle, (&map, &wps), (65.95, 33.03), u, |sc| {
+        let start = sc.start_state(1065.47);
+        let mut checked = 0;
+        for mode in [Mode::TrackWise, Mode::Horizon] {
+            let cfg = PlannerConfig {
+                mode,
+                ..PlannerConfig::default()
+            };
+            let mut planner = Planner::<5>::new(cfg).unwrap();
+            let plans = plan_line(&mut planner, sc, &start);
+            let depths: Vec<f32> = plans.iter().map(|p| p.depth).collect();
+            let certified: Vec<f32> = plans.iter().map(|p| p.certified_min_altitude).collect();
+            let world = |s: f32| World {
+                speed: vehicle.speed(),
+                flight_path_offset: alpha_max * s,
+                vertical_current: 0.0,
+            };
+            for bottom in &shifted {
+                let plan = (&depths[..], &certified[..]);
+                let what = format!("{mode:?}");
+                checked += certified_across(sc, (bottom, &start), plan, &what, (40, world));
+            }
+        }
+        checked
+    });
+    assert!(checked > 600, "{checked}");
 }

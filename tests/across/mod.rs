@@ -1,12 +1,15 @@
 //! Shared by the tests that sample the worlds a certificate claims
 //! (`tests/certified.rs`, `tests/between.rs`): one open-loop flight of a
-//! plan in a world, the fixtures' lines, the `plan` tool's line, and the
-//! check that each certified altitude is at most the flown one.
+//! plan in a world, a world's bottom, the fixtures' lines, a line planned
+//! call by call, the `plan` tool's line, and the check that each
+//! certified altitude is at most the flown one.
 #![allow(dead_code)]
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 #![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
 
-use auvnav::{Profile, Scenario, TrackScore, VehicleState, Waypoints, World};
+use auvnav::{
+    Plan, Planner, Profile, Scenario, TrackScore, Uncertainty, VehicleState, Waypoints, World,
+};
 
 use crate::common::csv_column;
 use crate::tool;
@@ -92,4 +95,81 @@ pub fn tool_line(name: &str, args: &[&str]) -> (Vec<f32>, Vec<f32>) {
             .collect()
     };
     (value("depth"), value("certified_min_altitude"))
+}
+
+/// A linear congruential generator (Knuth's MMIX constants).
+pub struct Lcg(pub u64);
+impl Lcg {
+    /// Uniform in [0, 1).
+    pub fn unit(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+    /// Uniform in [−1, 1).
+    pub fn sym(&mut self) -> f32 {
+        2.0 * self.unit() - 1.0
+    }
+}
+
+/// A world's bottom: `b(x + s(x)) + v(x)` on a 2 m grid, `s` and `v` sums
+/// of three random sinusoids scaled into their bounds (or, for `corner`,
+/// the constant extremes).
+pub fn world_bottom(
+    map: &Profile<4096>,
+    u: &Uncertainty,
+    x0: f32,
+    rng: &mut Lcg,
+    corner: Option<(f32, f32)>,
+) -> Profile<8192> {
+    let (a, b) = (map.start(), map.end());
+    let n = (((b - a) / 2.0) as usize).min(8000);
+    let waves: Vec<(f32, f32, f32)> = (0..3)
+        .map(|_| {
+            (
+                rng.sym(),
+                200.0 + 800.0 * rng.unit(),
+                std::f32::consts::TAU * rng.unit(),
+            )
+        })
+        .collect();
+    let shape = |x: f32, k: usize| -> f32 {
+        let s: f32 = waves
+            .iter()
+            .map(|&(amp, len, ph)| amp * (std::f32::consts::TAU * x / len + ph + k as f32).sin())
+            .sum();
+        (s / 3.0).clamp(-1.0, 1.0)
+    };
+    let xs: Vec<f32> = (0..=n).map(|i| a + (b - a) * i as f32 / n as f32).collect();
+    let bs: Vec<f32> = xs
+        .iter()
+        .map(|&x| {
+            let (fs, fv) = corner.unwrap_or((shape(x, 0), shape(x, 7)));
+            let s = fs * u.offset_at(x, x0);
+            let v = fv * u.vertical();
+            map.depth_at((x + s).clamp(a, b)).unwrap() + v
+        })
+        .collect();
+    Profile::new(&xs, &bs).unwrap()
+}
+
+/// The line planned track by track from `start`, each call from the
+/// state the one before predicted, until a call fails (a start in the
+/// rock): each track's plan.
+pub fn plan_line<const K: usize>(
+    planner: &mut Planner<K>,
+    sc: &Scenario<'_, 3>,
+    start: &VehicleState<3>,
+) -> Vec<Plan<3>> {
+    let mut plans: Vec<Plan<3>> = Vec::new();
+    for n in 0..sc.waypoints().tracks() {
+        let st = plans.last().map_or(*start, |p| p.next_state);
+        let Ok(p) = planner.plan(sc, &st, n) else {
+            break;
+        };
+        plans.push(p);
+    }
+    plans
 }
