@@ -1404,6 +1404,21 @@ fn a_saturated_dive_begins_earlier_on_the_default_vehicle() {
     horizon_within("dive_earlier_default", 1.02, 5.182_672e6);
 }
 
+/// The dive begun a track earlier, where the restart's restoration does
+/// not find the climb before it (`check_planner.py --seed 3312 --vehicle
+/// tools/reference/vehicles/heavy.toml`, `unseen_3312_5`): track 4 dives
+/// at the pitch limit the whole track, 170 m above its bottom at its
+/// least (12.1e6 of the line's 13.1e6 m³), after track 3 held at its
+/// target. Restarted with track 3 at track 4's depth, the SQP ended
+/// worse, and the line's `J` was 1.335× the f64 beam search's best safe
+/// plan (9.835 625e6 m³), which climbs on track 2 at the pitch limit and
+/// sets track 3 112 m deeper. Restarted also with track 2 on its climb:
+/// 0.9989×.
+#[test]
+fn a_saturated_dive_begins_earlier_after_a_climb() {
+    horizon_within("climb_before", 1.0, 9.835_625e6);
+}
+
 /// A plateau whose scan stepped over a feasible window to a cliff
 /// (`make_lines.py`'s `unseen_5007_6`, seed 5007, the `fast` vehicle):
 /// track 2's climb is saturated for depths shallower than about 410 m,
