@@ -127,13 +127,13 @@ impl<const K: usize, const N: usize> Planner<K, N> {
                 .unwrap_or(iterations);
             // The track before the held one started on its climb too
             // (module docs): the restoration may not find it.
-            let (Some(b), Some(&lo)) = (g.checked_sub(1), bounds.lo.get(g.saturating_sub(1)))
-            else {
+            let Some(b) = g.checked_sub(1) else {
                 continue;
             };
-            if let Some(slot) = start.get_mut(b) {
-                *slot = lo;
-            }
+            let (Some(&lo), Some(slot)) = (bounds.lo.get(b), start.get_mut(b)) else {
+                continue;
+            };
+            *slot = lo;
             iterations = self
                 .sqp_restart(obj, &start, (h, bounds), (tol, 0.0, false), iterations)
                 .unwrap_or(iterations);
