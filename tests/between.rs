@@ -14,11 +14,10 @@ mod across;
 mod common;
 mod tool;
 
-use across::{Lcg, certified_across, fixture_line, plan_line, tool_line, world_bottom};
-use auvnav::{
-    Mode, PidGains, Planner, PlannerConfig, Profile, TransferFunction, Uncertainty, Vehicle,
-    VehicleConfig, World,
+use across::{
+    Lcg, certified_across, fixture_line, fixture_vehicle, plan_line, tool_line, world_bottom,
 };
+use auvnav::{Mode, Planner, PlannerConfig, Profile, World};
 use common::with_declared;
 
 /// The vertical current declared alone (`check_certified.py --seed 2553
@@ -32,27 +31,9 @@ use common::with_declared;
 /// across the declared current.
 #[test]
 fn the_certificate_bounds_every_current_between_its_samples() {
-    let mut cfg = VehicleConfig {
-        speed: 1.437,
-        sample_time: 0.0873,
-        ..VehicleConfig::default()
-    };
-    cfg.autopilot.pitch_limit = 13.56;
-    cfg.autopilot.depth_pid = PidGains {
-        kp: 1.858,
-        ki: 0.02291,
-        kd: 1.547,
-    };
-    cfg.autopilot.pitch_pid = PidGains {
-        kp: 1.734,
-        ki: 0.1259,
-        kd: 2.254,
-    };
-    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
-    let w_max = 0.0742;
-    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, 0.0, w_max).unwrap();
+    let (vehicle, u, (h_r, h_a), _) = fixture_vehicle("current_fine");
+    let w_max = u.vertical_current();
     let (x, b, map, wps) = fixture_line("current_fine");
-    let (h_r, h_a) = (41.13, 20.53);
     let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
     let bottom = Profile::<8192>::new(&x, &b).unwrap();
     let mut checked = 0;
@@ -85,28 +66,9 @@ fn the_certificate_bounds_every_current_between_its_samples() {
 /// declared offset.
 #[test]
 fn the_certificate_bounds_a_kink_between_its_offsets() {
-    let mut cfg = VehicleConfig {
-        speed: 0.8409,
-        sample_time: 0.248,
-        ..VehicleConfig::default()
-    };
-    cfg.autopilot.pitch_limit = 29.91;
-    cfg.autopilot.depth_pid = PidGains {
-        kp: 1.356,
-        ki: 0.02944,
-        kd: 1.867,
-    };
-    cfg.autopilot.pitch_pid = PidGains {
-        kp: 1.451,
-        ki: 0.1041,
-        kd: 2.88,
-    };
-    let plant = TransferFunction::<3>::pitch(&[-0.62], &[1.0, 1.45, 0.29]).unwrap();
-    let vehicle = Vehicle::new(&cfg, plant).unwrap();
-    let alpha_max = 1.84;
-    let u = Uncertainty::new(0.0, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
+    let (vehicle, u, (h_r, h_a), _) = fixture_vehicle("offset_kink");
+    let alpha_max = u.flight_path_offset();
     let (x, b, map, wps) = fixture_line("offset_kink");
-    let (h_r, h_a) = (66.67, 45.6);
     let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
     let bottom = Profile::<8192>::new(&x, &b).unwrap();
     let (depths, certified) = tool_line("offset_kink", &[]);
@@ -136,22 +98,9 @@ fn the_certificate_bounds_a_kink_between_its_offsets() {
 /// least altitude in 801 worlds across the declared speed.
 #[test]
 fn the_certificate_bounds_every_speed_between_its_samples() {
-    let mut cfg = VehicleConfig {
-        speed: 0.9309,
-        sample_time: 0.224,
-        ..VehicleConfig::default()
-    };
-    cfg.autopilot.pitch_limit = 15.75;
-    cfg.autopilot.depth_pid = PidGains {
-        kp: 1.44,
-        ki: 0.0,
-        kd: 1.808,
-    };
-    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
-    let eps = 0.00918;
-    let u = Uncertainty::new(0.0, 0.0, 0.0, eps, 0.0, 0.0).unwrap();
+    let (vehicle, u, (h_r, h_a), _) = fixture_vehicle("speed_phase");
+    let eps = u.speed();
     let (x, b, map, wps) = fixture_line("speed_phase");
-    let (h_r, h_a) = (25.11, 10.41);
     let d0 = map.depth_at(wps.positions()[0]).unwrap() - h_r;
     let bottom = Profile::<8192>::new(&x, &b).unwrap();
     let mut checked = 0;
@@ -185,21 +134,8 @@ fn the_certificate_bounds_every_speed_between_its_samples() {
 /// either way.
 #[test]
 fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
-    let mut cfg = VehicleConfig {
-        speed: 1.565,
-        sample_time: 0.185,
-        ..VehicleConfig::default()
-    };
-    cfg.autopilot.pitch_limit = 13.94;
-    cfg.autopilot.elevator_limit = 16.84;
-    cfg.autopilot.pitch_pid = PidGains {
-        kp: 1.696,
-        ki: 0.1005,
-        kd: 2.204,
-    };
-    let vehicle = Vehicle::new(&cfg, TransferFunction::C_AUV4).unwrap();
-    let alpha_max = 0.0649;
-    let u = Uncertainty::new(6.88, 0.0, 0.0, 0.0, alpha_max, 0.0).unwrap();
+    let (vehicle, u, altitudes, d0) = fixture_vehicle("offset_jitter");
+    let alpha_max = u.flight_path_offset();
     let (_, _, map, wps) = fixture_line("offset_jitter");
     let x0 = wps.positions()[0];
     let mut rng = Lcg(0x2431_0ff5);
@@ -207,8 +143,8 @@ fn the_certificate_bounds_every_flight_path_offset_between_its_samples() {
         .iter()
         .map(|&s| world_bottom(&map, &u, x0, &mut rng, Some((s, 0.0))))
         .collect();
-    let checked = with_declared(&vehicle, (&map, &wps), (65.95, 33.03), u, |sc| {
-        let start = sc.start_state(1065.47);
+    let checked = with_declared(&vehicle, (&map, &wps), altitudes, u, |sc| {
+        let start = sc.start_state(d0.unwrap());
         let mut checked = 0;
         for mode in [Mode::TrackWise, Mode::Horizon] {
             let cfg = PlannerConfig {

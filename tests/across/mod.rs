@@ -8,7 +8,8 @@
 #![allow(clippy::arithmetic_side_effects, clippy::cast_precision_loss)]
 
 use auvnav::{
-    Plan, Planner, Profile, Scenario, TrackScore, Uncertainty, VehicleState, Waypoints, World,
+    PidGains, Plan, Planner, Profile, Scenario, TfKind, TrackScore, TransferFunction, Uncertainty,
+    Vehicle, VehicleConfig, VehicleState, Waypoints, World,
 };
 
 use crate::common::csv_column;
@@ -42,6 +43,61 @@ pub fn fixture_line(name: &str) -> (Vec<f32>, Vec<f32>, Profile<4096>, Waypoints
     let map = Profile::<4096>::new(&x, &b).unwrap();
     let wps = Waypoints::<16>::new(&csv_column(&format!("{rel}.waypoints.csv"), 1)).unwrap();
     (x, b, map, wps)
+}
+
+/// The vehicle of fixture `name` as the `plan` tool reads it from
+/// `NAME.toml` (the library's defaults for the keys it leaves out, the
+/// C-AUV4 plant without a `[plant]` table): the vehicle, the declared
+/// uncertainty, `(h_r, h_a)` (m) and its `initial_depth` if it sets one
+/// (m).
+pub fn fixture_vehicle(name: &str) -> (Vehicle<3>, Uncertainty, (f32, f32), Option<f32>) {
+    let path = format!(
+        "{}/tests/fixtures/horizon/{name}.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let t: toml::Table = std::fs::read_to_string(&path).unwrap().parse().unwrap();
+    let num = |t: &toml::Table, k: &str| t.get(k).map(|v| v.as_float().unwrap() as f32);
+    let nums = |v: &toml::Value| -> Vec<f32> {
+        let a = v.as_array().unwrap();
+        a.iter().map(|x| x.as_float().unwrap() as f32).collect()
+    };
+    let pid = |k: &str, d: PidGains| {
+        t.get(k)
+            .and_then(toml::Value::as_table)
+            .map_or(d, |g| PidGains {
+                kp: num(g, "kp").unwrap_or(d.kp),
+                ki: num(g, "ki").unwrap_or(d.ki),
+                kd: num(g, "kd").unwrap_or(d.kd),
+            })
+    };
+    let mut cfg = VehicleConfig::default();
+    cfg.speed = num(&t, "speed").unwrap_or(cfg.speed);
+    cfg.sample_time = num(&t, "sample_time").unwrap_or(cfg.sample_time);
+    let ap = &mut cfg.autopilot;
+    ap.pitch_limit = num(&t, "pitch_limit").unwrap_or(ap.pitch_limit);
+    ap.elevator_limit = num(&t, "elevator_limit").unwrap_or(ap.elevator_limit);
+    ap.depth_pid = pid("depth_pid", ap.depth_pid);
+    ap.pitch_pid = pid("pitch_pid", ap.pitch_pid);
+    let plant = t.get("plant").map_or(TransferFunction::C_AUV4, |p| {
+        assert_eq!(p["kind"].as_str(), Some("pitch"));
+        TransferFunction::new(TfKind::Pitch, &nums(&p["num"]), &nums(&p["den"])).unwrap()
+    });
+    let bound = |k: &str| num(&t, k).unwrap_or(0.0);
+    let u = Uncertainty::new(
+        bound("horizontal_uncertainty"),
+        bound("nav_drift"),
+        bound("vertical_uncertainty"),
+        bound("speed_uncertainty"),
+        bound("flight_path_offset"),
+        bound("vertical_current"),
+    )
+    .unwrap();
+    let altitudes = (
+        num(&t, "reference_altitude").unwrap(),
+        num(&t, "min_altitude").unwrap(),
+    );
+    let vehicle = Vehicle::new(&cfg, plant).unwrap();
+    (vehicle, u, altitudes, num(&t, "initial_depth"))
 }
 
 /// Flies `depths` from `start` in `world` over `bottom` and asserts that
