@@ -1419,6 +1419,22 @@ fn a_saturated_dive_begins_earlier_after_a_climb() {
     horizon_within("climb_before", 1.0, 9.835_625e6);
 }
 
+/// A later track freed in a narrow window off a plateau (`check_planner.py
+/// --seed 3331 --vehicle tools/reference/vehicles/fast.toml`,
+/// `unseen_3331_5`): track 1's dive is saturated for depths shallower
+/// than about 855 m, where the SQP stopped (712 m), and track 2 was held
+/// at its minimum altitude. Between 855 and 870 m track 1's depth lifts
+/// track 2's least altitude by up to 0.7 m, so that track 2 flies 1.8 m
+/// deeper; the 9-point scan stepped over that window to a cliff, and the
+/// line's `J` was 1.018× the f64 beam search's best safe plan
+/// (1.022 111e7 m³). The cliff's bisected step off the plateau is now the
+/// held edge's, and its restart starts where the held track is freed
+/// most (`src/plan/jump/`): 1.0027×.
+#[test]
+fn a_held_track_is_freed_where_most() {
+    horizon_within("freed_most", 1.01, 1.022_111e7);
+}
+
 /// A plateau whose scan stepped over a feasible window to a cliff
 /// (`make_lines.py`'s `unseen_5007_6`, seed 5007, the `fast` vehicle):
 /// track 2's climb is saturated for depths shallower than about 410 m,

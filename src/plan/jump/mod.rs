@@ -68,8 +68,9 @@
 //! where the straight path is infeasible (track 3 down to 42 m): no
 //! local step gets there, and the line's `J` was 1.51× the f64 best.
 //! The edge now steps further off, by the band and doubling
-//! ([`FREE_STEPS`] tail flights at most), until the held track is freed:
-//! 1.0027×; `unseen_1706_7` (`second`, the same shape) 3.22× → 1.0025×.
+//! ([`FREE_STEPS`] tail flights at most), until the held track is freed
+//! (then on while it is freed more: below): 1.0027×; `unseen_1706_7`
+//! (`second`, the same shape) 3.22× → 1.0025×.
 //! Where no step frees it, the point just off the edge is still a start
 //! if it is as feasible as the plateau: on `check_planner.py --seed 2005
 //! --vehicle tools/reference/vehicles/rate.toml` (`unseen_2005_5`) `z_3`
@@ -77,6 +78,27 @@
 //! linearization sees `z_3` take over holding track 4, and `z_2` moves
 //! 87 m deeper: 3.40× → 1.0002×. (Off Monterey 1's plateau the point is
 //! 5 m short: no restart.)
+//!
+//! The window off the edge that frees a later track can be narrower than
+//! the scan's step, and the track freed most a little further off than
+//! its first freed point: on `check_planner.py --seed 3331 --vehicle
+//! tools/reference/vehicles/fast.toml` (`unseen_3331_5`) track 1's dive
+//! is saturated for `z_1` shallower than about 855 m, where the SQP
+//! stopped (712 m), with track 2 held at its minimum altitude; between
+//! 855 and 870 m `z_1` lifts track 2's least altitude by up to 0.7 m,
+//! and track 2 can fly 1.8 m deeper. The 9-point scan stepped from the
+//! plateau (849 m) to a cliff (987 m), so no step off the plateau was
+//! within the band and no held edge was sought: the line 1.018× the f64
+//! best safe plan. The cliff's bisection's step off the plateau to
+//! within the band now serves as the held edge's step, and of the steps
+//! further off (the band, doubling) the edge's start is the one that
+//! frees the held track most, stepping on while each frees it more than
+//! the last: track 2 freed by 0.13 m just off the edge (858 m), by
+//! 0.67 m 8 m further; 1.0027×. On the 304 random lines 9 lower
+//! (`unseen_5001_7` −4.7 %, `unseen_5004_2` −1.4 %, `unseen_5012_2`
+//! −1.1 %, `unseen_5018_6` −0.49 %), 2 higher (by 0.054 % at most),
+//! +0.98 % flights (the cliff's step alone: 6 lower, +0.82 %); track by
+//! track and the 24 shared runs the same.
 
 use crate::num::max;
 use crate::optim::Bounds;
@@ -171,13 +193,15 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // pass comes after them.)
         let Steps { held, edge, .. } = steps;
         let cliff = steps.cliff.filter(|_| !kept && !later && held.is_none());
-        bisect_steps(
+        // (No scanned step off the plateau within the band: the cliff's
+        // bisected one, module docs.)
+        let held = held.or(bisect_steps(
             obj,
             (flown, &out.z),
             (edge, cliff),
             (band, plateau),
             &mut keep,
-        );
+        ));
         let at = (out.z, out.j, v_now);
         if best.is_none() && !later {
             self.scanned.note(at, j, held);
@@ -225,11 +249,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// `(on, off)` of the scan is bisected [`EDGE`] times (one flight of
     /// the tail each), and the point off the plateau (within the band)
     /// returned, with its `J` as its score: the restart is kept only if it
-    /// ends lower. A later track held (`later`) must be freed there by
-    /// more than the slack; else the point steps further off, by the band
-    /// and doubling, [`FREE_STEPS`] times at most (module docs); not
-    /// freed, the point just off the edge if it is as feasible as the
-    /// plateau (within the slack). `None` when track `j` is not held, or
+    /// ends lower. A later track held (`later`) must be freed by more
+    /// than the slack: the point there and the points further off (the
+    /// band, doubling, [`FREE_STEPS`] times at most) are tried outwards
+    /// while each frees it more than the last, and the one that frees it
+    /// most is the start (module docs); not freed, the point just off the
+    /// edge if it is as feasible as the plateau (within the slack). `None` when track `j` is not held, or
     /// the later track is neither freed nor the edge's point feasible.
     fn held_edge(
         &self,
@@ -264,13 +289,21 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         // linearization there sees no trade either. Just off the edge it
         // may be freed by a hair; further off, by more (module docs).
         let away = if off.0 < on.0 { -band } else { band };
-        let mut step = 0.0;
+        // The step that frees it most: outwards while each step frees it
+        // more than the last (module docs).
+        let (mut step, mut most) = (0.0, None::<(f32, [f32; K])>);
         for _ in 0..=FREE_STEPS {
             let start = with_depth(z, j, off.0 + step);
-            if obj.least_at((at_j, j), &start, g).ok()? > least + slack {
-                return Some(((0.0, off.1), start));
+            let freed = obj.least_at((at_j, j), &start, g).ok()?;
+            if freed > least + slack && most.is_none_or(|(m, _)| freed > m) {
+                most = Some((freed, start));
+            } else if most.is_some() {
+                break;
             }
             step = if step == 0.0 { away } else { 2.0 * step };
+        }
+        if let Some((_, start)) = most {
+            return Some(((0.0, off.1), start));
         }
         // Not freed, but as feasible as the plateau (within the slack):
         // the linearization there sees `z_j`, which may take over holding

@@ -132,13 +132,16 @@ pub(super) fn scan_steps<const K: usize, const N: usize>(
 /// ([`flat`]) to beyond the band, for the first point off the plateau
 /// within it. Each point flown of `z` (tracks before `j` flown as in
 /// `flown`) is offered to `keep`, which tells whether it was kept.
+/// Returns the cliff's step off the plateau to within the band that its
+/// bisection found, `(on, off)`, if any: a held edge's step (module docs
+/// of `jump`).
 pub(super) fn bisect_steps<const K: usize, const N: usize>(
     obj: &mut PlanObjective<'_, N>,
     (flown, z): ((&[TrackScore; K], &VehicleState<N>, usize), &[f32; K]),
     (edge, cliff): (Option<Step>, Option<Step>),
     (band, plateau): (f32, (f32, f32)),
     keep: &mut impl FnMut(Point) -> bool,
-) {
+) -> Option<Step> {
     let mut kept = false;
     if let Some(step) = edge {
         bisect(obj, (flown, z), step, |p| {
@@ -146,19 +149,21 @@ pub(super) fn bisect_steps<const K: usize, const N: usize>(
             Some(p.2 <= band)
         });
     }
-    let Some(step) = cliff.filter(|_| !kept) else {
-        return;
-    };
+    let step = cliff.filter(|_| !kept)?;
+    let (mut on, mut within) = (step.0, None);
     bisect(obj, (flown, z), step, |p| {
         if flat(p, plateau) {
+            on = p;
             Some(true)
         } else if p.2 <= band {
             keep(p);
+            within = Some((on, p));
             None
         } else {
             Some(false)
         }
     });
+    within
 }
 
 /// `step` `(a, b)` bisected [`EDGE`] times, one flight of the tail each
