@@ -1435,6 +1435,20 @@ fn a_held_track_is_freed_where_most() {
     horizon_within("freed_most", 1.01, 1.022_111e7);
 }
 
+/// A stride promised by flights, not by a toothed tangent
+/// (`check_planner.py --seed 3345`, `unseen_3345_7`, default vehicle):
+/// the SQP stopped with track 1 12.9 m above its target, the line's `J`
+/// falling 4.2e3 m³ per metre of its depth but with teeth, so that the
+/// tangent read −961 m³/m and the stride's promise was 0.5 % (under its
+/// 5 %); the line's `J` was 1.018× the f64 beam search's best safe plan
+/// (3.470 161e6 m³), which flies track 1 on its boundary 12.9 m deeper.
+/// The promise measured by two plain flights, at 1 %
+/// (`src/plan/stride.rs`): 1.0027×.
+#[test]
+fn a_stride_is_promised_by_flights_not_the_tangent() {
+    horizon_within("stride_teeth", 1.01, 3.470_161e6);
+}
+
 /// A plateau whose scan stepped over a feasible window to a cliff
 /// (`make_lines.py`'s `unseen_5007_6`, seed 5007, the `fast` vehicle):
 /// track 2's climb is saturated for depths shallower than about 410 m,
