@@ -95,12 +95,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// cold call's horizon of `h` tracks in `bounds`, feasible within
     /// `tol` (m), after `iterations` so far; returns the iterations so far
     /// (a kept restart's). One plain flight to check the first track,
-    /// two for the promise, then at most [`STRIDES`] SQP restarts (each with a second from its
-    /// end off the plateaus, where it went back: module docs): the first
-    /// that ends lower
-    /// ends the search, kept only if it gains more than [`GAIN`] (a
-    /// nearer basin found by the band's stride is not looked past). Not
-    /// inlined: its state stays off the SQP runs' stack.
+    /// two for the promise, then at most [`STRIDES`] SQP restarts (each
+    /// with a second from its end off the plateaus, where it went back:
+    /// module docs): the first that ends lower ends the search, kept only
+    /// if it gains more than [`GAIN`] (a nearer basin found by the band's
+    /// stride is not looked past). Not inlined: its state stays off the
+    /// SQP runs' stack.
     #[inline(never)]
     pub(super) fn stride_first(
         &mut self,

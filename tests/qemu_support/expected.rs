@@ -16,7 +16,7 @@ pub const HORIZON_K5: [TrackPlan; 5] = [
         min_altitude: f32::from_bits(0x42785364) /* 62.081436 */,
         objective: f32::from_bits(0x4b2e33b3) /* 11416499.0 */,
         iterations: 3,
-        evaluations: 156,
+        evaluations: 159,
         history_len: 4,
         history_hash: 0xb9341b3d,
         next_x: f32::from_bits(0x441c41f0) /* 625.0303 */,

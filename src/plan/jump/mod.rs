@@ -254,8 +254,9 @@ impl<const K: usize, const N: usize> Planner<K, N> {
     /// band, doubling, [`FREE_STEPS`] times at most) are tried outwards
     /// while each frees it more than the last, and the one that frees it
     /// most is the start (module docs); not freed, the point just off the
-    /// edge if it is as feasible as the plateau (within the slack). `None` when track `j` is not held, or
-    /// the later track is neither freed nor the edge's point feasible.
+    /// edge if it is as feasible as the plateau (within the slack). `None`
+    /// when track `j` is not held, or the later track is neither freed nor
+    /// the edge's point feasible.
     fn held_edge(
         &self,
         obj: &mut PlanObjective<'_, N>,
