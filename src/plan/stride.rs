@@ -73,6 +73,7 @@ use crate::optim::{Bounds, First};
 
 use super::Planner;
 use super::objective::PlanObjective;
+use super::scan::with_depth;
 use super::solve::horizon_flight;
 
 /// The share of the band `h_r − h_a` by which the first track must fly
@@ -130,10 +131,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         let mut stride = band;
         for _ in 0..STRIDES {
-            let mut z = self.work.z;
-            if let Some(first) = z.first_mut() {
-                *first = max(min(z1 + dir * stride, hi), lo);
-            }
+            let z = first_moved(&self.work.z, (z1, lo, hi), dir * stride);
             let (kept, kept_v) = (self.work.mark(), obj.last_violation);
             let start = (tol, 0.0, false);
             self.restart_plateaus = None;
@@ -159,9 +157,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         }
         iterations
     }
-}
 
-impl<const K: usize, const N: usize> Planner<K, N> {
     /// The stride's direction (+1 deeper, −1 shallower): the side of the
     /// SQP's end, `z_1` moved by the band within `[lo, hi]` (m) and the
     /// other depths held, whose horizon `J` is the lower, where it is
@@ -174,10 +170,7 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         band: f32,
     ) -> Option<f32> {
         let mut side = |d: f32| {
-            let mut z = self.work.z;
-            if let Some(first) = z.first_mut() {
-                *first = max(min(z1 + d * band, hi), lo);
-            }
+            let z = first_moved(&self.work.z, (z1, lo, hi), d * band);
             horizon_flight(obj, &z).map_or(f32::INFINITY, |(j, _, _)| j)
         };
         let (deeper, shallower) = (side(1.0), side(-1.0));
@@ -188,6 +181,12 @@ impl<const K: usize, const N: usize> Planner<K, N> {
         };
         (j < (1.0 - PROMISE) * self.work.j).then_some(dir)
     }
+}
+
+/// `z` with its first depth `z1` moved `by` (m) within `[lo, hi]`: a
+/// stride's start, or the promise's side.
+fn first_moved<const K: usize>(z: &[f32; K], (z1, lo, hi): (f32, f32, f32), by: f32) -> [f32; K] {
+    with_depth(z, 0, max(min(z1 + by, hi), lo))
 }
 
 /// A restart's end `left` with the depths in `bits` (its plateaus) put
